@@ -1,0 +1,36 @@
+// The `detslam` command: subcommands run, eval, synth (see --help).
+#include <spdlog/spdlog.h>
+
+#include <exception>
+#include <iostream>
+
+#include "commands.h"
+#include "detslam/core/check.h"
+
+int main(int argc, char** argv) {
+  CLI::App app{"detslam: RGB-D SLAM for dynamic scenes (Det-SLAM method)"};
+  app.require_subcommand(1);
+  bool verbose = false;
+  app.add_flag("-v,--verbose", verbose, "Debug logging");
+  app.parse_complete_callback([&] {
+    spdlog::set_level(verbose ? spdlog::level::debug : spdlog::level::info);
+  });
+  detslam::app::AddRunCommand(app);
+  detslam::app::AddEvalCommand(app);
+  detslam::app::AddSynthCommand(app);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  } catch (const detslam::InputError& e) {
+    std::cerr << "error: " << e.what() << "\n";
+    return 1;
+  } catch (const detslam::app::CommandFailed& e) {
+    std::cerr << "error: " << e.what() << "\n";
+    return e.code;
+  } catch (const std::exception& e) {
+    std::cerr << "error: " << e.what() << "\n";
+    return 1;
+  }
+  return 0;
+}

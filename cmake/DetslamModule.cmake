@@ -1,0 +1,45 @@
+# detslam_module(NAME DEPS ...)
+# Builds src/detslam/NAME/*.cc (without *_test.cc) into the library detslam_NAME, and every
+# src/detslam/NAME/*_test.cc into one test binary detslam_NAME_test (ctest label "unit" unless the
+# test's name starts with Data, which gets the label "data"). A folder without sources yields an
+# INTERFACE library so that dependants link regardless.
+set(DETSLAM_WARNINGS -Wall -Wextra -Werror)
+
+function(detslam_module name)
+  cmake_parse_arguments(ARG "" "" "DEPS" ${ARGN})
+  set(dir "${CMAKE_SOURCE_DIR}/src/detslam/${name}")
+  file(GLOB all_sources CONFIGURE_DEPENDS "${dir}/*.cc")
+  file(GLOB test_sources CONFIGURE_DEPENDS "${dir}/*_test.cc")
+  set(lib_sources ${all_sources})
+  if(test_sources)
+    list(REMOVE_ITEM lib_sources ${test_sources})
+  endif()
+  set(target detslam_${name})
+  if(lib_sources)
+    add_library(${target} STATIC ${lib_sources})
+    target_include_directories(${target} PUBLIC "${CMAKE_SOURCE_DIR}/src")
+    target_link_libraries(${target} PUBLIC ${ARG_DEPS})
+    target_compile_options(${target} PRIVATE ${DETSLAM_WARNINGS})
+  else()
+    add_library(${target} INTERFACE)
+    target_include_directories(${target} INTERFACE "${CMAKE_SOURCE_DIR}/src")
+    target_link_libraries(${target} INTERFACE ${ARG_DEPS})
+  endif()
+  if(DETSLAM_BUILD_TESTS AND test_sources)
+    add_executable(${target}_test ${test_sources})
+    target_link_libraries(${target}_test PRIVATE ${target} detslam_test_support GTest::gmock
+                          GTest::gtest_main)
+    target_compile_options(${target}_test PRIVATE ${DETSLAM_WARNINGS})
+    detslam_discover_tests(${target}_test)
+  endif()
+endfunction()
+
+# Registers a gtest binary with ctest: test suites named Data* (real data from ../shared) get the
+# label "data", suites named Integration* the label "integration", all others "unit".
+function(detslam_discover_tests target)
+  gtest_discover_tests(${target} TEST_FILTER "-Data*:Integration*" PROPERTIES LABELS unit
+                       DISCOVERY_TIMEOUT 60)
+  gtest_discover_tests(${target} TEST_FILTER "Data*" PROPERTIES LABELS data DISCOVERY_TIMEOUT 60)
+  gtest_discover_tests(${target} TEST_FILTER "Integration*" PROPERTIES LABELS integration
+                       DISCOVERY_TIMEOUT 60)
+endfunction()
