@@ -1,0 +1,85 @@
+#!/usr/bin/env python3
+"""Replaces one named section of docs/BENCHMARKS.md with markdown read from stdin.
+
+Benchmark commands pipe their own output here, so every number in docs/BENCHMARKS.md was written
+by the command that measured it. The section is stamped with the machine, the date and the command.
+Usage: some_benchmark | bench/update_section.py NAME "command line that produced it"
+"""
+import datetime
+import os
+import platform
+import re
+import subprocess
+import sys
+
+
+def machine() -> str:
+    cpu = platform.processor() or platform.machine()
+    try:
+        with open("/proc/cpuinfo") as f:
+            for line in f:
+                if line.startswith("model name"):
+                    cpu = line.split(":", 1)[1].strip()
+                    break
+    except OSError:
+        pass
+    mem = ""
+    try:
+        with open("/proc/meminfo") as f:
+            kb = int(f.readline().split()[1])
+            mem = f", {kb / 1024 / 1024:.0f} GiB RAM"
+    except (OSError, ValueError, IndexError):
+        pass
+    return f"{cpu}, {os.cpu_count()} cores{mem}, {platform.system()} {platform.release()}"
+
+
+def commit() -> str:
+    try:
+        out = subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True,
+                             cwd=os.path.dirname(os.path.abspath(__file__)), check=True)
+        dirty = subprocess.run(["git", "status", "--porcelain", "--untracked-files=no"],
+                               capture_output=True, text=True, check=True,
+                               cwd=os.path.dirname(os.path.abspath(__file__))).stdout.strip()
+        return out.stdout.strip() + (" (uncommitted changes)" if dirty else "")
+    except (OSError, subprocess.CalledProcessError):
+        return "unknown"
+
+
+def main() -> int:
+    if len(sys.argv) < 3:
+        print(__doc__, file=sys.stderr)
+        return 2
+    name, command = sys.argv[1], sys.argv[2]
+    if not re.fullmatch(r"[a-z0-9_-]+", name):
+        print(f"bad section name {name!r}", file=sys.stderr)
+        return 2
+    body = sys.stdin.read().rstrip() + "\n"
+    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    path = os.path.join(root, "docs", "BENCHMARKS.md")
+    text = ""
+    if os.path.exists(path):
+        with open(path) as f:
+            text = f.read()
+    if not text.startswith("# Benchmarks"):
+        text = ("# Benchmarks\n\nEvery section below is written by the command named in it "
+                "(never by hand); rerun that command to refresh it.\n")
+    stamp = (f"_Written by `{command}` on {datetime.datetime.now().strftime('%Y-%m-%d %H:%M')}; "
+             f"machine: {machine()}; commit {commit()}._\n\n")
+    begin, end = f"<!-- BEGIN {name} -->", f"<!-- END {name} -->"
+    block = f"{begin}\n{stamp}{body}{end}"
+    pattern = re.compile(re.escape(begin) + r".*?" + re.escape(end), re.S)
+    if pattern.search(text):
+        text = pattern.sub(lambda _: block, text)
+    else:
+        text = text.rstrip() + "\n\n" + block + "\n"
+    tmp = path + ".tmp"
+    os.makedirs(os.path.dirname(path), exist_ok=True)
+    with open(tmp, "w") as f:
+        f.write(text)
+    os.replace(tmp, path)
+    print(f"updated section '{name}' of {path}", file=sys.stderr)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
