@@ -1,0 +1,71 @@
+// ORB extraction and matching speed on a real 640x480 TUM frame (single thread).
+// Usage: detslam_bench_orb [--benchmark_...]; the image is read from
+// $DETSLAM_SHARED/data/tum/... (default: the configured shared folder).
+#include <benchmark/benchmark.h>
+
+#include <cstdlib>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+#include <opencv2/core/utility.hpp>
+#include <opencv2/imgcodecs.hpp>
+
+#include "detslam/features/matcher.h"
+#include "detslam/features/orb_extractor.h"
+
+namespace {
+
+constexpr const char* kFrameA =
+    "data/tum/rgbd_dataset_freiburg2_desk_subset50/rgb/1311868164.363181.png";
+constexpr const char* kFrameB =
+    "data/tum/rgbd_dataset_freiburg2_desk_subset50/rgb/1311868164.399026.png";
+
+cv::Mat LoadGray(const char* relative) {
+  const char* env = std::getenv("DETSLAM_SHARED");
+  const std::string root = env != nullptr && *env != '\0' ? env : DETSLAM_SHARED_DIR_DEFAULT;
+  return cv::imread(root + "/" + relative, cv::IMREAD_GRAYSCALE);
+}
+
+void BM_OrbExtract(benchmark::State& state) {
+  cv::setNumThreads(1);  // single-threaded figure: no OpenCV worker threads
+  const cv::Mat gray = LoadGray(kFrameA);
+  if (gray.empty()) {
+    state.SkipWithError("shared TUM frame not found (set DETSLAM_SHARED)");
+    return;
+  }
+  const detslam::OrbExtractor extractor{detslam::OrbOptions{}};
+  std::vector<cv::KeyPoint> keypoints;
+  cv::Mat descriptors;
+  for (auto _ : state) {
+    extractor.Extract(gray, cv::Mat(), &keypoints, &descriptors);
+    benchmark::DoNotOptimize(descriptors.data);
+  }
+  state.counters["keypoints"] = static_cast<double>(keypoints.size());
+}
+BENCHMARK(BM_OrbExtract)->Unit(benchmark::kMillisecond);
+
+void BM_MatchBruteForce(benchmark::State& state) {
+  cv::setNumThreads(1);
+  const cv::Mat a = LoadGray(kFrameA), b = LoadGray(kFrameB);
+  if (a.empty() || b.empty()) {
+    state.SkipWithError("shared TUM frames not found (set DETSLAM_SHARED)");
+    return;
+  }
+  const detslam::OrbExtractor extractor{detslam::OrbOptions{}};
+  std::vector<cv::KeyPoint> kp_a, kp_b;
+  cv::Mat desc_a, desc_b;
+  extractor.Extract(a, cv::Mat(), &kp_a, &desc_a);
+  extractor.Extract(b, cv::Mat(), &kp_b, &desc_b);
+  std::vector<cv::DMatch> matches;
+  for (auto _ : state) {
+    matches = detslam::MatchBruteForce(kp_a, desc_a, kp_b, desc_b, detslam::MatchOptions{});
+    benchmark::DoNotOptimize(matches.data());
+  }
+  state.counters["matches"] = static_cast<double>(matches.size());
+}
+BENCHMARK(BM_MatchBruteForce)->Unit(benchmark::kMillisecond);
+
+}  // namespace
+
+BENCHMARK_MAIN();

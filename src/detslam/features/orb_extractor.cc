@@ -1,0 +1,250 @@
+#include "detslam/features/orb_extractor.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstring>
+#include <sstream>
+
+#include <opencv2/features2d.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "detslam/core/check.h"
+#include "detslam/features/keypoint_distribution.h"
+#include "detslam/features/orb_pattern.h"
+
+namespace detslam {
+namespace {
+
+constexpr int kPatchSize = 31;
+constexpr int kHalfPatch = 15;
+constexpr int kEdgeThreshold = 19;           // border added around each level image
+constexpr int kDetectBorder = kEdgeThreshold - 3;  // keypoints lie at least this far inside
+constexpr int kCellSize = 35;                // FAST threshold cells (ORB-SLAM's W)
+constexpr int kFastRadius = 3;               // FAST needs this many pixels around a candidate
+constexpr double kPi = 3.14159265358979323846;
+
+// Half-widths of the radius-15 circular patch, per row offset 0..15: u^2 + v^2 <= 15^2.
+std::array<int, kHalfPatch + 1> CircleHalfWidths() {
+  std::array<int, kHalfPatch + 1> u_max{};
+  for (int v = 0; v <= kHalfPatch; ++v) {
+    u_max[v] = static_cast<int>(std::floor(std::sqrt(double(kHalfPatch * kHalfPatch - v * v))));
+  }
+  return u_max;
+}
+
+// Intensity-centroid orientation in degrees [0, 360) of the patch centred at `center`.
+float CentroidAngle(const cv::Mat& image, cv::Point center,
+                    const std::array<int, kHalfPatch + 1>& u_max) {
+  const int step = static_cast<int>(image.step1());
+  const uint8_t* c = image.ptr<uint8_t>(center.y) + center.x;
+  long m10 = 0, m01 = 0;
+  for (int u = -kHalfPatch; u <= kHalfPatch; ++u) m10 += u * c[u];
+  for (int v = 1; v <= kHalfPatch; ++v) {
+    long row_sum_diff = 0;  // sum over u of (I(u, v) - I(u, -v)), multiplied by v below
+    const int d = u_max[v];
+    for (int u = -d; u <= d; ++u) {
+      const int below = c[u + v * step];
+      const int above = c[u - v * step];
+      row_sum_diff += below - above;
+      m10 += u * (below + above);
+    }
+    m01 += v * row_sum_diff;
+  }
+  double angle = std::atan2(static_cast<double>(m01), static_cast<double>(m10)) * 180.0 / kPi;
+  if (angle < 0) angle += 360.0;
+  if (angle >= 360.0) angle -= 360.0;
+  return static_cast<float>(angle);
+}
+
+// 256-bit steered BRIEF on the blurred image at `center` with orientation `angle_deg`.
+void ComputeDescriptor(const cv::Mat& blurred, cv::Point center, float angle_deg, uint8_t* out) {
+  const double a = angle_deg * kPi / 180.0;
+  const float ca = static_cast<float>(std::cos(a));
+  const float sa = static_cast<float>(std::sin(a));
+  const int step = static_cast<int>(blurred.step1());
+  const uint8_t* c = blurred.ptr<uint8_t>(center.y) + center.x;
+  const auto sample = [&](int x, int y) {
+    const int xr = static_cast<int>(std::lround(x * ca - y * sa));
+    const int yr = static_cast<int>(std::lround(x * sa + y * ca));
+    return c[yr * step + xr];
+  };
+  const std::array<BriefPair, 256>& pattern = OrbPattern();
+  for (int byte = 0; byte < 32; ++byte) {
+    uint8_t value = 0;
+    for (int bit = 0; bit < 8; ++bit) {
+      const BriefPair& p = pattern[byte * 8 + bit];
+      if (sample(p.x1, p.y1) < sample(p.x2, p.y2)) value |= static_cast<uint8_t>(1u << bit);
+    }
+    out[byte] = value;
+  }
+}
+
+bool Masked(const cv::Mat& mask, float x, float y) {
+  const int c = std::clamp(static_cast<int>(std::lround(x)), 0, mask.cols - 1);
+  const int r = std::clamp(static_cast<int>(std::lround(y)), 0, mask.rows - 1);
+  return mask.at<uint8_t>(r, c) != 0;
+}
+
+}  // namespace
+
+bool OrbOptions::Check(std::string* error) const {
+  std::ostringstream os;
+  if (num_features < 1) os << "num_features must be >= 1 (got " << num_features << "); ";
+  if (!(scale_factor > 1.0) || !(scale_factor < 10.0)) {
+    os << "scale_factor must be in (1, 10) (got " << scale_factor << "); ";
+  }
+  if (num_levels < 1 || num_levels > 32) {
+    os << "num_levels must be in [1, 32] (got " << num_levels << "); ";
+  }
+  if (min_th_fast < 1 || min_th_fast > 254) {
+    os << "min_th_fast must be in [1, 254] (got " << min_th_fast << "); ";
+  }
+  if (ini_th_fast < min_th_fast || ini_th_fast > 254) {
+    os << "ini_th_fast must be in [min_th_fast, 254] (got " << ini_th_fast << "); ";
+  }
+  const std::string message = os.str();
+  if (error != nullptr) *error = message;
+  return message.empty();
+}
+
+OrbExtractor::OrbExtractor(const OrbOptions& options) : options_(options) {
+  std::string error;
+  if (!options_.Check(&error)) throw InputError("OrbOptions: " + error);
+  const int levels = options_.num_levels;
+  scale_factors_.resize(levels);
+  inv_scale_factors_.resize(levels);
+  level_sigma2_.resize(levels);
+  inv_level_sigma2_.resize(levels);
+  for (int l = 0; l < levels; ++l) {
+    scale_factors_[l] = l == 0 ? 1.0 : scale_factors_[l - 1] * options_.scale_factor;
+    inv_scale_factors_[l] = 1.0 / scale_factors_[l];
+    level_sigma2_[l] = scale_factors_[l] * scale_factors_[l];
+    inv_level_sigma2_[l] = 1.0 / level_sigma2_[l];
+  }
+  // Geometric series n_l = n_0 f^l with f = 1 / scale_factor, the remainder to the top level.
+  features_per_level_.resize(levels);
+  const double f = 1.0 / options_.scale_factor;
+  double desired = options_.num_features * (1.0 - f) / (1.0 - std::pow(f, levels));
+  int assigned = 0;
+  for (int l = 0; l + 1 < levels; ++l) {
+    features_per_level_[l] = static_cast<int>(std::lround(desired));
+    assigned += features_per_level_[l];
+    desired *= f;
+  }
+  features_per_level_[levels - 1] = std::max(0, options_.num_features - assigned);
+}
+
+void OrbExtractor::Extract(const cv::Mat& gray, const cv::Mat& ignore_mask,
+                           std::vector<cv::KeyPoint>* keypoints, cv::Mat* descriptors) const {
+  DETSLAM_CHECK(keypoints != nullptr && descriptors != nullptr);
+  if (gray.empty() || gray.type() != CV_8UC1) {
+    throw InputError("OrbExtractor::Extract: image must be a non-empty CV_8UC1 image");
+  }
+  if (!ignore_mask.empty() && (ignore_mask.type() != CV_8UC1 || ignore_mask.size() != gray.size())) {
+    throw InputError("OrbExtractor::Extract: ignore_mask must be empty or CV_8UC1 of image size");
+  }
+  keypoints->clear();
+  static const std::array<int, kHalfPatch + 1> u_max = CircleHalfWidths();
+
+  std::vector<cv::KeyPoint> result;
+  std::vector<std::array<uint8_t, 32>> desc_rows;
+  result.reserve(options_.num_features + 16);
+  desc_rows.reserve(options_.num_features + 16);
+
+  cv::Mat level_image;  // the previous level, resized into the next
+  std::vector<cv::KeyPoint> candidates;
+  for (int level = 0; level < options_.num_levels; ++level) {
+    const double scale = scale_factors_[level];
+    const cv::Size size(static_cast<int>(std::lround(gray.cols * inv_scale_factors_[level])),
+                        static_cast<int>(std::lround(gray.rows * inv_scale_factors_[level])));
+    if (size.width <= 2 * kDetectBorder + 1 || size.height <= 2 * kDetectBorder + 1) break;
+    if (level == 0) {
+      level_image = gray;
+    } else {
+      cv::Mat resized;
+      cv::resize(level_image, resized, size, 0, 0, cv::INTER_LINEAR);
+      level_image = resized;
+    }
+    cv::Mat padded, blurred;
+    cv::copyMakeBorder(level_image, padded, kEdgeThreshold, kEdgeThreshold, kEdgeThreshold,
+                       kEdgeThreshold, cv::BORDER_REFLECT_101);
+
+    // FAST once at the low threshold with non-max suppression over the detection area. A corner's
+    // FAST score does not depend on the threshold, so the corners of a cell that score at least
+    // ini_th_fast are those a run at ini_th_fast would find; cells without any fall back to all.
+    const int x0 = kDetectBorder - kFastRadius, y0 = kDetectBorder - kFastRadius;
+    const cv::Rect area(x0, y0, size.width - 2 * x0, size.height - 2 * y0);
+    candidates.clear();
+    cv::FAST(level_image(area), candidates, options_.min_th_fast, true);
+    const int region_w = size.width - 2 * kDetectBorder;
+    const int region_h = size.height - 2 * kDetectBorder;
+    const int cols = std::max(1, region_w / kCellSize);
+    const int rows = std::max(1, region_h / kCellSize);
+    const double cell_w = static_cast<double>(region_w) / cols;
+    const double cell_h = static_cast<double>(region_h) / rows;
+    std::vector<int> cell_of;
+    cell_of.reserve(candidates.size());
+    std::vector<char> cell_strong(cols * rows, 0);
+    size_t kept = 0;
+    for (cv::KeyPoint& kp : candidates) {
+      kp.pt.x += x0;
+      kp.pt.y += y0;
+      if (!ignore_mask.empty() && Masked(ignore_mask, kp.pt.x * scale, kp.pt.y * scale)) continue;
+      const int cx = std::clamp(static_cast<int>((kp.pt.x - kDetectBorder) / cell_w), 0, cols - 1);
+      const int cy = std::clamp(static_cast<int>((kp.pt.y - kDetectBorder) / cell_h), 0, rows - 1);
+      const int cell = cy * cols + cx;
+      if (kp.response >= options_.ini_th_fast) cell_strong[cell] = 1;
+      candidates[kept++] = kp;
+      cell_of.push_back(cell);
+    }
+    candidates.resize(kept);
+    size_t selected = 0;
+    for (size_t i = 0; i < candidates.size(); ++i) {
+      if (candidates[i].response >= options_.ini_th_fast || !cell_strong[cell_of[i]]) {
+        candidates[selected++] = candidates[i];
+      }
+    }
+    candidates.resize(selected);
+
+    const std::vector<size_t> chosen = DistributeQuadtree(
+        candidates, kDetectBorder, static_cast<float>(size.width - kDetectBorder), kDetectBorder,
+        static_cast<float>(size.height - kDetectBorder), features_per_level_[level]);
+    if (chosen.empty()) continue;
+
+    cv::GaussianBlur(padded, blurred, cv::Size(7, 7), 2, 2, cv::BORDER_REFLECT_101);
+    for (size_t i : chosen) {
+      const cv::KeyPoint& c = candidates[i];
+      const cv::Point center(static_cast<int>(std::lround(c.pt.x)) + kEdgeThreshold,
+                             static_cast<int>(std::lround(c.pt.y)) + kEdgeThreshold);
+      cv::KeyPoint kp;
+      kp.angle = CentroidAngle(padded, center, u_max);
+      kp.response = c.response;
+      kp.octave = level;
+      kp.size = static_cast<float>(kPatchSize * scale);
+      kp.pt = cv::Point2f(static_cast<float>(c.pt.x * scale), static_cast<float>(c.pt.y * scale));
+      desc_rows.emplace_back();
+      ComputeDescriptor(blurred, center, kp.angle, desc_rows.back().data());
+      result.push_back(kp);
+    }
+  }
+
+  *keypoints = std::move(result);
+  descriptors->create(static_cast<int>(desc_rows.size()), 32, CV_8UC1);
+  for (size_t i = 0; i < desc_rows.size(); ++i) {
+    std::memcpy(descriptors->ptr<uint8_t>(static_cast<int>(i)), desc_rows[i].data(), 32);
+  }
+}
+
+int DescriptorDistance(const uint8_t* a, const uint8_t* b) {
+  int distance = 0;
+  for (int i = 0; i < 32; i += 8) {
+    uint64_t wa, wb;
+    std::memcpy(&wa, a + i, 8);
+    std::memcpy(&wb, b + i, 8);
+    distance += __builtin_popcountll(wa ^ wb);
+  }
+  return distance;
+}
+
+}  // namespace detslam

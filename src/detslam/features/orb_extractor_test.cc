@@ -1,0 +1,223 @@
+#include "detslam/features/orb_extractor.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <vector>
+
+#include <opencv2/imgproc.hpp>
+
+#include "detslam/core/check.h"
+#include "detslam/features/orb_pattern.h"
+#include "detslam/features/texture_for_test.h"
+
+namespace detslam {
+namespace {
+
+using detslam::testing::MakeTexture;
+
+struct Extraction {
+  std::vector<cv::KeyPoint> keypoints;
+  cv::Mat descriptors;
+};
+
+Extraction Extract(const cv::Mat& image, const cv::Mat& mask = cv::Mat(),
+                   const OrbOptions& options = OrbOptions()) {
+  Extraction e;
+  OrbExtractor(options).Extract(image, mask, &e.keypoints, &e.descriptors);
+  return e;
+}
+
+TEST(OrbOptionsTest, CheckRejectsBadValues) {
+  std::string error;
+  EXPECT_TRUE(OrbOptions().Check(&error)) << error;
+  OrbOptions bad;
+  bad.scale_factor = 1.0;
+  EXPECT_FALSE(bad.Check(&error));
+  EXPECT_NE(error.find("scale_factor"), std::string::npos);
+  bad = OrbOptions();
+  bad.ini_th_fast = 5;  // below min_th_fast
+  EXPECT_FALSE(bad.Check(&error));
+  EXPECT_THROW(OrbExtractor{bad}, InputError);
+}
+
+TEST(OrbExtractorTest, RejectsWrongInput) {
+  const OrbExtractor extractor{OrbOptions()};
+  std::vector<cv::KeyPoint> kps;
+  cv::Mat desc;
+  EXPECT_THROW(extractor.Extract(cv::Mat(), cv::Mat(), &kps, &desc), InputError);
+  EXPECT_THROW(extractor.Extract(cv::Mat(480, 640, CV_8UC3), cv::Mat(), &kps, &desc), InputError);
+  EXPECT_THROW(extractor.Extract(cv::Mat(480, 640, CV_8UC1, cv::Scalar(0)),
+                                 cv::Mat(10, 10, CV_8UC1), &kps, &desc),
+               InputError);
+}
+
+TEST(OrbExtractorTest, ScaleTablesAndLevelTargets) {
+  const OrbExtractor extractor{OrbOptions()};
+  ASSERT_EQ(extractor.num_levels(), 8);
+  for (int l = 0; l < 8; ++l) {
+    EXPECT_NEAR(extractor.scale_factors()[l], std::pow(1.2, l), 1e-12);
+    EXPECT_NEAR(extractor.level_sigma2()[l], std::pow(1.44, l), 1e-12);
+    EXPECT_NEAR(extractor.inv_level_sigma2()[l] * extractor.level_sigma2()[l], 1.0, 1e-12);
+  }
+  const std::vector<int>& n = extractor.features_per_level();
+  EXPECT_EQ(std::accumulate(n.begin(), n.end(), 0), 1000);
+  // n0 = N (1 - f) / (1 - f^L), f = 1 / 1.2.
+  const double f = 1.0 / 1.2;
+  EXPECT_NEAR(n[0], 1000 * (1 - f) / (1 - std::pow(f, 8)), 0.5);
+  for (int l = 1; l + 1 < 8; ++l) EXPECT_NEAR(n[l], n[0] * std::pow(f, l), 1.0) << l;
+}
+
+TEST(OrbPatternTest, PairsInsidePatchDistinctAndSpread) {
+  const auto& pattern = OrbPattern();
+  double sum = 0, sum2 = 0;
+  for (const BriefPair& p : pattern) {
+    for (int v : {p.x1, p.y1, p.x2, p.y2}) {
+      EXPECT_LE(std::abs(v), kOrbPatternHalfSize);
+      sum += v;
+      sum2 += v * v;
+    }
+    EXPECT_FALSE(p.x1 == p.x2 && p.y1 == p.y2);
+  }
+  const double mean = sum / 1024, sd = std::sqrt(sum2 / 1024 - mean * mean);
+  EXPECT_NEAR(mean, 0.0, 1.0);
+  EXPECT_NEAR(sd, 31.0 / 5.0, 1.0);  // Gaussian sigma 6.2, slightly narrowed by the clipping
+}
+
+TEST(OrbExtractorTest, KeypointsSpreadOverImageAndFieldsValid) {
+  const cv::Mat image = MakeTexture(640, 480, 1);
+  const Extraction e = Extract(image);
+  ASSERT_EQ(e.descriptors.rows, static_cast<int>(e.keypoints.size()));
+  EXPECT_EQ(e.descriptors.cols, 32);
+  EXPECT_EQ(e.descriptors.type(), CV_8UC1);
+  EXPECT_GE(e.keypoints.size(), 950u);
+  EXPECT_LE(e.keypoints.size(), 1000u);
+  int cells[4][4] = {};
+  for (const cv::KeyPoint& kp : e.keypoints) {
+    ASSERT_GE(kp.pt.x, 0);
+    ASSERT_LT(kp.pt.x, 640);
+    ASSERT_GE(kp.pt.y, 0);
+    ASSERT_LT(kp.pt.y, 480);
+    ASSERT_GE(kp.angle, 0);
+    ASSERT_LT(kp.angle, 360);
+    ASSERT_GE(kp.octave, 0);
+    ASSERT_LT(kp.octave, 8);
+    EXPECT_NEAR(kp.size, 31 * std::pow(1.2, kp.octave), 1e-3);
+    EXPECT_GE(kp.response, 7);
+    ++cells[static_cast<int>(kp.pt.y / 120)][static_cast<int>(kp.pt.x / 160)];
+  }
+  for (int r = 0; r < 4; ++r) {
+    for (int c = 0; c < 4; ++c) EXPECT_GE(cells[r][c], 25) << "cell " << r << "," << c;
+  }
+}
+
+TEST(OrbExtractorTest, PerLevelCountsFollowGeometricSeries) {
+  const OrbExtractor extractor{OrbOptions()};
+  std::vector<cv::KeyPoint> kps;
+  cv::Mat desc;
+  extractor.Extract(MakeTexture(640, 480, 2), cv::Mat(), &kps, &desc);
+  std::vector<int> counts(8, 0);
+  for (const cv::KeyPoint& kp : kps) ++counts[kp.octave];
+  for (int l = 0; l < 8; ++l) {
+    const int target = extractor.features_per_level()[l];
+    EXPECT_LE(counts[l], target) << "level " << l;
+    EXPECT_GE(counts[l], 0.85 * target) << "level " << l;
+  }
+  EXPECT_GT(counts[0], counts[4]);
+}
+
+TEST(OrbExtractorTest, IgnoreMaskRegionsHaveNoKeypointsAndBudgetMovesElsewhere) {
+  const cv::Mat image = MakeTexture(640, 480, 3);
+  cv::Mat mask(480, 640, CV_8UC1, cv::Scalar(0));
+  cv::rectangle(mask, cv::Rect(200, 100, 220, 300), cv::Scalar(255), cv::FILLED);  // a "person"
+  cv::circle(mask, cv::Point(80, 80), 50, cv::Scalar(1), cv::FILLED);  // any non-zero value
+  const Extraction unmasked = Extract(image);
+  const Extraction masked = Extract(image, mask);
+  int inside_before = 0;
+  for (const cv::KeyPoint& kp : unmasked.keypoints) {
+    inside_before += mask.at<uint8_t>(cvRound(kp.pt.y), cvRound(kp.pt.x)) != 0;
+  }
+  EXPECT_GT(inside_before, 150);  // the mask covers a real share of the budget
+  for (const cv::KeyPoint& kp : masked.keypoints) {
+    EXPECT_EQ(mask.at<uint8_t>(cvRound(kp.pt.y), cvRound(kp.pt.x)), 0)
+        << kp.pt << " octave " << kp.octave;
+  }
+  EXPECT_GE(masked.keypoints.size(), 930u);
+}
+
+// Angle (degrees) of the direction `angle_deg` after the linear part of `affine`.
+double MapAngle(const cv::Mat& affine, double angle_deg) {
+  const double a = angle_deg * CV_PI / 180.0;
+  const double dx = affine.at<double>(0, 0) * std::cos(a) + affine.at<double>(0, 1) * std::sin(a);
+  const double dy = affine.at<double>(1, 0) * std::cos(a) + affine.at<double>(1, 1) * std::sin(a);
+  return std::atan2(dy, dx) * 180.0 / CV_PI;
+}
+
+double AngleError(double a, double b) {
+  double d = std::fmod(std::abs(a - b), 360.0);
+  return std::min(d, 360.0 - d);
+}
+
+TEST(OrbExtractorTest, RotatingImageRotatesKeypointAngles) {
+  const cv::Mat image = MakeTexture(640, 480, 4);
+  for (double theta : {25.0, -70.0, 150.0}) {
+    const cv::Mat affine = cv::getRotationMatrix2D(cv::Point2f(320, 240), theta, 1.0);
+    cv::Mat rotated;
+    cv::warpAffine(image, rotated, affine, image.size(), cv::INTER_LINEAR, cv::BORDER_REFLECT_101);
+    const Extraction a = Extract(image), b = Extract(rotated);
+    std::vector<double> errors;
+    for (const cv::KeyPoint& ka : a.keypoints) {
+      const cv::Point2d p(affine.at<double>(0, 0) * ka.pt.x + affine.at<double>(0, 1) * ka.pt.y +
+                              affine.at<double>(0, 2),
+                          affine.at<double>(1, 0) * ka.pt.x + affine.at<double>(1, 1) * ka.pt.y +
+                              affine.at<double>(1, 2));
+      if (std::hypot(p.x - 320, p.y - 240) > 200) continue;  // stay clear of the warped border
+      for (const cv::KeyPoint& kb : b.keypoints) {
+        if (kb.octave == ka.octave && std::hypot(kb.pt.x - p.x, kb.pt.y - p.y) < 1.5) {
+          errors.push_back(AngleError(kb.angle, MapAngle(affine, ka.angle)));
+          break;
+        }
+      }
+    }
+    ASSERT_GE(errors.size(), 100u) << "theta " << theta;
+    std::sort(errors.begin(), errors.end());
+    EXPECT_LT(errors[errors.size() / 2], 4.0) << "median angle error, theta " << theta;
+    EXPECT_LT(errors[errors.size() * 8 / 10], 12.0) << "80th percentile, theta " << theta;
+  }
+}
+
+TEST(OrbExtractorTest, DeterministicAcrossRunsAndInstances) {
+  const cv::Mat image = MakeTexture(640, 480, 5);
+  const Extraction a = Extract(image), b = Extract(image);
+  ASSERT_EQ(a.keypoints.size(), b.keypoints.size());
+  for (size_t i = 0; i < a.keypoints.size(); ++i) {
+    EXPECT_EQ(a.keypoints[i].pt, b.keypoints[i].pt);
+    EXPECT_EQ(a.keypoints[i].angle, b.keypoints[i].angle);
+    EXPECT_EQ(a.keypoints[i].octave, b.keypoints[i].octave);
+    EXPECT_EQ(a.keypoints[i].response, b.keypoints[i].response);
+  }
+  EXPECT_EQ(cv::norm(a.descriptors, b.descriptors, cv::NORM_HAMMING), 0.0);
+}
+
+TEST(DescriptorDistanceTest, HandMadeValues) {
+  uint8_t a[32] = {}, b[32] = {};
+  EXPECT_EQ(DescriptorDistance(a, b), 0);
+  b[0] = 0x01;
+  EXPECT_EQ(DescriptorDistance(a, b), 1);
+  b[31] = 0xF0;  // 4 more bits, in the last word
+  EXPECT_EQ(DescriptorDistance(a, b), 5);
+  b[9] = 0xFF;
+  b[17] = 0x81;
+  EXPECT_EQ(DescriptorDistance(a, b), 15);
+  EXPECT_EQ(DescriptorDistance(b, a), 15);
+  std::fill(a, a + 32, 0xFF);
+  std::fill(b, b + 32, 0x00);
+  EXPECT_EQ(DescriptorDistance(a, b), 256);
+  std::fill(b, b + 32, 0x55);  // every other bit
+  EXPECT_EQ(DescriptorDistance(a, b), 128);
+}
+
+}  // namespace
+}  // namespace detslam
