@@ -58,9 +58,9 @@ std::vector<ListedImage> ReadImageList(const std::string& dir, const std::string
   int previous_line = 0;
   ForEachDataLine(list, [&](int line, const std::vector<std::string>& fields) {
     if (fields.size() != 2) {
-      throw InputError(list, line,
-                       "expected 2 fields 'timestamp filename', got " +
-                           std::to_string(fields.size()));
+      throw InputError(
+          list, line,
+          "expected 2 fields 'timestamp filename', got " + std::to_string(fields.size()));
     }
     ListedImage image{ParseStampField(list, line, fields[0]), ResolveAgainst(dir, fields[1])};
     if (!images.empty()) CheckOrder(list, line, image.stamp, images.back().stamp, previous_line);
@@ -87,7 +87,8 @@ std::vector<RgbdFrameRef> ReadAssociationFile(const std::string& dir, const std:
     f.rgb_path = ResolveAgainst(dir, fields[1]);
     f.depth_stamp = ParseStampField(list, line, fields[2]);
     f.depth_path = ResolveAgainst(dir, fields[3]);
-    if (!frames.empty()) CheckOrder(list, line, f.rgb_stamp, frames.back().rgb_stamp, previous_line);
+    if (!frames.empty())
+      CheckOrder(list, line, f.rgb_stamp, frames.back().rgb_stamp, previous_line);
     CheckImageExists(list, line, f.rgb_path);
     CheckImageExists(list, line, f.depth_path);
     frames.push_back(std::move(f));
@@ -99,7 +100,9 @@ std::vector<RgbdFrameRef> ReadAssociationFile(const std::string& dir, const std:
 std::string DescribeMat(const cv::Mat& m) {
   std::ostringstream os;
   os << m.cols << "x" << m.rows << ", " << m.channels() << " channel(s), "
-     << (m.depth() == CV_8U ? "8-bit" : m.depth() == CV_16U ? "16-bit" : "other depth type");
+     << (m.depth() == CV_8U    ? "8-bit"
+         : m.depth() == CV_16U ? "16-bit"
+                               : "other depth type");
   return os.str();
 }
 
@@ -152,10 +155,9 @@ RgbdDataset RgbdDataset::Open(const std::string& dir, const DatasetOptions& opti
   const auto pairs = AssociateTimestamps(rgb_stamps, depth_stamps, assoc);
   if (pairs.empty()) {
     std::ostringstream os;
-    os << "no colour image has a depth image within " << options.max_difference_s
-       << " s (offset " << options.offset_s << " s); nothing associated between " << rgb_list
-       << " (" << rgb.size() << " images) and " << depth_list << " (" << depth.size()
-       << " images)";
+    os << "no colour image has a depth image within " << options.max_difference_s << " s (offset "
+       << options.offset_s << " s); nothing associated between " << rgb_list << " (" << rgb.size()
+       << " images) and " << depth_list << " (" << depth.size() << " images)";
     throw InputError(dataset.dir_, 0, os.str());
   }
   for (const auto& [i, j] : pairs) {

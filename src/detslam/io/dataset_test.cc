@@ -19,7 +19,7 @@ constexpr int kWidth = 8;
 constexpr int kHeight = 6;
 
 // A fresh folder per test, removed afterwards.
-class DatasetTest : public ::testing::Test {
+class RgbdDatasetTest : public ::testing::Test {
  protected:
   void SetUp() override {
     static int counter = 0;
@@ -77,7 +77,7 @@ class DatasetTest : public ::testing::Test {
   PinholeCamera camera_;
 };
 
-TEST_F(DatasetTest, AssociatesGreedilyWithinWindow) {
+TEST_F(RgbdDatasetTest, AssociatesGreedilyWithinWindow) {
   WriteSequence({"1.000000", "1.033000", "1.066000"}, {"1.005000", "1.040000", "1.100000"});
   const RgbdDataset d = RgbdDataset::Open(dir_.string(), {});
   // 1.066 has no depth within 0.02 s (closest 1.100 is 0.034 away).
@@ -95,7 +95,7 @@ TEST_F(DatasetTest, AssociatesGreedilyWithinWindow) {
   EXPECT_TRUE(fs::equivalent(d.groundtruth_path(), Path("groundtruth.txt")));
 }
 
-TEST_F(DatasetTest, OffsetShiftsDepthStamps) {
+TEST_F(RgbdDatasetTest, OffsetShiftsDepthStamps) {
   WriteSequence({"1.000000", "1.100000"}, {"1.050000", "1.150000"});
   const std::string error = OpenError();
   EXPECT_THAT(error, HasSubstr("nothing associated"));
@@ -109,7 +109,7 @@ TEST_F(DatasetTest, OffsetShiftsDepthStamps) {
   EXPECT_THAT(OpenError(options), HasSubstr("max_difference_s"));
 }
 
-TEST_F(DatasetTest, LoadConvertsDepthToMetres) {
+TEST_F(RgbdDatasetTest, LoadConvertsDepthToMetres) {
   WriteText("rgb.txt", "1.0 rgb/a.png\n");
   WriteText("depth.txt", "1.0 depth/a.png\n");
   WriteColour("rgb/a.png", 50);
@@ -132,12 +132,12 @@ TEST_F(DatasetTest, LoadConvertsDepthToMetres) {
                   static_cast<float>(7500.0 / 5208.0));
 }
 
-TEST_F(DatasetTest, LoadConvertsGrayAndFourChannelColour) {
+TEST_F(RgbdDatasetTest, LoadConvertsGrayAndFourChannelColour) {
   WriteText("rgb.txt", "1.0 rgb/g.png\n2.0 rgb/c.png\n");
   WriteText("depth.txt", "1.0 depth/a.png\n2.0 depth/b.png\n");
   ASSERT_TRUE(cv::imwrite(Path("rgb/g.png"), cv::Mat(kHeight, kWidth, CV_8UC1, cv::Scalar(77))));
-  ASSERT_TRUE(cv::imwrite(Path("rgb/c.png"),
-                          cv::Mat(kHeight, kWidth, CV_8UC4, cv::Scalar(1, 2, 3, 128))));
+  ASSERT_TRUE(
+      cv::imwrite(Path("rgb/c.png"), cv::Mat(kHeight, kWidth, CV_8UC4, cv::Scalar(1, 2, 3, 128))));
   WriteDepth("depth/a.png", 1000);
   WriteDepth("depth/b.png", 1000);
   const RgbdDataset d = RgbdDataset::Open(dir_.string(), {});
@@ -150,13 +150,13 @@ TEST_F(DatasetTest, LoadConvertsGrayAndFourChannelColour) {
   EXPECT_EQ(four.bgr.at<cv::Vec3b>(5, 7), cv::Vec3b(1, 2, 3));
 }
 
-TEST_F(DatasetTest, LoadRejectsBadImagesNamingTheFile) {
+TEST_F(RgbdDatasetTest, LoadRejectsBadImagesNamingTheFile) {
   WriteText("rgb.txt", "1.0 rgb/a.png\n2.0 rgb/b.png\n3.0 rgb/c.png\n4.0 rgb/d.png\n");
   WriteText("depth.txt", "1.0 depth/a.png\n2.0 depth/b.png\n3.0 depth/c.png\n4.0 depth/d.png\n");
   for (const char* name : {"a", "b", "c"}) WriteColour(std::string("rgb/") + name + ".png", 0);
   WriteText("rgb/d.png", "not a png");
   ASSERT_TRUE(cv::imwrite(Path("depth/a.png"), cv::Mat(kHeight, kWidth, CV_8UC1)));  // 8-bit
-  WriteDepth("depth/b.png", 1, kWidth + 2);                                            // size
+  WriteDepth("depth/b.png", 1, kWidth + 2);                                          // size
   WriteDepth("depth/c.png", 1);
   WriteDepth("depth/d.png", 1);
   const RgbdDataset d = RgbdDataset::Open(dir_.string(), {});
@@ -181,7 +181,7 @@ TEST_F(DatasetTest, LoadRejectsBadImagesNamingTheFile) {
   EXPECT_NO_THROW(d.Load(2, camera_));
 }
 
-TEST_F(DatasetTest, MissingFolderAndListsAreErrors) {
+TEST_F(RgbdDatasetTest, MissingFolderAndListsAreErrors) {
   EXPECT_THAT(OpenError(), HasSubstr("rgb.txt"));
   WriteText("rgb.txt", "");
   EXPECT_THAT(OpenError(), HasSubstr("depth.txt"));
@@ -196,7 +196,7 @@ TEST_F(DatasetTest, MissingFolderAndListsAreErrors) {
   }
 }
 
-TEST_F(DatasetTest, MalformedLinesNameFileAndLine) {
+TEST_F(RgbdDatasetTest, MalformedLinesNameFileAndLine) {
   WriteSequence({"1.0"}, {"1.0"});
   WriteText("rgb.txt", "# header\n1.0 rgb/1.0.png\n2.0\n");
   EXPECT_THAT(OpenError(), HasSubstr(Path("rgb.txt") + ":3: expected 2 fields"));
@@ -204,7 +204,7 @@ TEST_F(DatasetTest, MalformedLinesNameFileAndLine) {
   EXPECT_THAT(OpenError(), HasSubstr(Path("rgb.txt") + ":2: malformed timestamp 'abc'"));
 }
 
-TEST_F(DatasetTest, OutOfOrderStampsNameTheBreakingLine) {
+TEST_F(RgbdDatasetTest, OutOfOrderStampsNameTheBreakingLine) {
   WriteSequence({"1.0", "2.0", "3.0"}, {"1.0", "2.0", "3.0"});
   WriteText("depth.txt", "1.0 depth/1.0.png\n# c\n3.0 depth/3.0.png\n2.0 depth/2.0.png\n");
   const std::string error = OpenError();
@@ -214,7 +214,7 @@ TEST_F(DatasetTest, OutOfOrderStampsNameTheBreakingLine) {
   EXPECT_THAT(OpenError(), HasSubstr(Path("depth.txt") + ":2:"));
 }
 
-TEST_F(DatasetTest, MissingImageNamesListLineAndImage) {
+TEST_F(RgbdDatasetTest, MissingImageNamesListLineAndImage) {
   WriteSequence({"1.0", "2.0"}, {"1.0", "2.0"});
   fs::remove(Path("rgb/2.0.png"));
   const std::string error = OpenError();
@@ -223,10 +223,11 @@ TEST_F(DatasetTest, MissingImageNamesListLineAndImage) {
   EXPECT_THAT(error, HasSubstr("rgb/2.0.png"));
 }
 
-TEST_F(DatasetTest, ExplicitAssociationFile) {
+TEST_F(RgbdDatasetTest, ExplicitAssociationFile) {
   WriteSequence({"1.0", "2.0", "3.0"}, {"1.01", "2.01", "3.5"});
-  WriteText("assoc.txt", "# ts rgb ts depth\n1.0 rgb/1.0.png 3.5 depth/3.5.png\n"
-                         "3.0 rgb/3.0.png 1.01 depth/1.01.png extra columns are ignored\n");
+  WriteText("assoc.txt",
+            "# ts rgb ts depth\n1.0 rgb/1.0.png 3.5 depth/3.5.png\n"
+            "3.0 rgb/3.0.png 1.01 depth/1.01.png extra columns are ignored\n");
   DatasetOptions options;
   options.association_file = "assoc.txt";  // relative to the dataset folder
   const RgbdDataset d = RgbdDataset::Open(dir_.string(), options);
@@ -237,7 +238,8 @@ TEST_F(DatasetTest, ExplicitAssociationFile) {
 
   WriteText("assoc.txt", "1.0 rgb/1.0.png 1.01\n");
   EXPECT_THAT(OpenError(options), HasSubstr(Path("assoc.txt") + ":1: expected at least 4"));
-  WriteText("assoc.txt", "2.0 rgb/2.0.png 2.01 depth/2.01.png\n1.0 rgb/1.0.png 1.01 depth/1.01.png\n");
+  WriteText("assoc.txt",
+            "2.0 rgb/2.0.png 2.01 depth/2.01.png\n1.0 rgb/1.0.png 1.01 depth/1.01.png\n");
   EXPECT_THAT(OpenError(options), HasSubstr(Path("assoc.txt") + ":2:"));
   WriteText("assoc.txt", "1.0 rgb/1.0.png 1.01 depth/missing.png\n");
   EXPECT_THAT(OpenError(options), HasSubstr("depth/missing.png"));

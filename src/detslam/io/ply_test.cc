@@ -46,8 +46,7 @@ float FloatLe(const std::string& bytes, size_t offset) {
 }
 
 std::string TempPath(const std::string& name) {
-  return (fs::temp_directory_path() /
-          ("detslam_io_ply_" + std::to_string(::getpid()) + "_" + name))
+  return (fs::temp_directory_path() / ("detslam_io_ply_" + std::to_string(::getpid()) + "_" + name))
       .string();
 }
 

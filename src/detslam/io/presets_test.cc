@@ -52,7 +52,8 @@ TEST(Presets, TumAndBonnValues) {
 }
 
 TEST(Presets, ChosenFromFolderName) {
-  const fs::path root = fs::temp_directory_path() / ("detslam_io_presets_" + std::to_string(::getpid()));
+  const fs::path root =
+      fs::temp_directory_path() / ("detslam_io_presets_" + std::to_string(::getpid()));
   EXPECT_DOUBLE_EQ(
       PresetForDataset((root / "rgbd_dataset_freiburg3_walking_xyz").string()).camera.fx, 535.4);
   EXPECT_DOUBLE_EQ(PresetForDataset((root / "rgbd_dataset_freiburg2_desk/").string()).camera.fx,

@@ -33,8 +33,8 @@ bool ParseDoubleText(const std::string& text, double* out) {
 // Integers; a real with an integral value ("640.0") is accepted too.
 bool ParseIntText(const std::string& text, int* out) {
   double v = 0;
-  if (!ParseDoubleText(text, &v) || v != std::floor(v) ||
-      v < std::numeric_limits<int>::min() || v > std::numeric_limits<int>::max()) {
+  if (!ParseDoubleText(text, &v) || v != std::floor(v) || v < std::numeric_limits<int>::min() ||
+      v > std::numeric_limits<int>::max()) {
     return false;
   }
   *out = static_cast<int>(v);
@@ -84,7 +84,8 @@ void Flatten(const std::string& path, const YAML::Node& node, const std::string&
 
 class Reader {
  public:
-  Reader(std::string path, Entries entries) : path_(std::move(path)), entries_(std::move(entries)) {}
+  Reader(std::string path, Entries entries)
+      : path_(std::move(path)), entries_(std::move(entries)) {}
 
   bool Has(const std::string& key) const { return entries_.count(key) > 0; }
 
@@ -218,7 +219,8 @@ bool IsPlainKey(const std::string& key) {
 // Numbers stay bare (typed the same on read-back), everything else is quoted.
 std::string FormatExtraValue(const std::string& value) {
   double d = 0;
-  if (ParseDoubleText(value, &d) && value.find_first_not_of("0123456789+-.eE") == std::string::npos) {
+  if (ParseDoubleText(value, &d) &&
+      value.find_first_not_of("0123456789+-.eE") == std::string::npos) {
     return value;
   }
   return Quote(value);
@@ -262,9 +264,9 @@ bool Settings::GetBool(const std::string& key, bool fallback) const {
   if (it == extra.end()) return fallback;
   bool v = false;
   if (!ParseBoolText(it->second, &v)) {
-    throw InputError(source, 0,
-                     "key '" + key + "' must be a boolean (0/1, true/false), got '" + it->second +
-                         "'");
+    throw InputError(
+        source, 0,
+        "key '" + key + "' must be a boolean (0/1, true/false), got '" + it->second + "'");
   }
   return v;
 }
@@ -347,8 +349,8 @@ void WriteSettings(const std::string& path, const Settings& settings) {
       {"Camera.width", std::to_string(c.width)},
       {"Camera.height", std::to_string(c.height)},
       // ORB-SLAM3 v1.0 reads the frame rate as an integer.
-      {"Camera.fps", c.fps == std::round(c.fps) ? std::to_string(std::lround(c.fps))
-                                                : FormatReal(c.fps)},
+      {"Camera.fps",
+       c.fps == std::round(c.fps) ? std::to_string(std::lround(c.fps)) : FormatReal(c.fps)},
       {"Camera.RGB", c.rgb_order ? "1" : "0"},
       {"Stereo.ThDepth", FormatReal(c.th_depth)},
       {"Stereo.b", FormatReal(c.bf / c.fx)},

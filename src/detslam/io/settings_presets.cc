@@ -113,8 +113,8 @@ Settings PresetForDataset(const std::string& dataset_dir) {
   }
   if (matches.size() > 1) {
     throw InputError(dataset_dir, 0,
-                     "folder name '" + folder + "' matches several camera presets (" +
-                         matches[0] + ", " + matches[1] + "); pass the settings with --config FILE");
+                     "folder name '" + folder + "' matches several camera presets (" + matches[0] +
+                         ", " + matches[1] + "); pass the settings with --config FILE");
   }
   spdlog::info("{}: using camera preset {}", dataset_dir, matches[0]);
   return PresetByName(matches[0]);

@@ -153,8 +153,8 @@ TEST_F(SettingsTest, NestedMapsAreFlattenedToDottedKeys) {
 }
 
 TEST_F(SettingsTest, MissingRequiredKeysNameFileAndKey) {
-  for (const std::string key : {"Camera.fx", "Camera.fy", "Camera.cx", "Camera.cy",
-                                "Camera.width", "Camera.height"}) {
+  for (const std::string key :
+       {"Camera.fx", "Camera.fy", "Camera.cx", "Camera.cy", "Camera.width", "Camera.height"}) {
     std::istringstream in(kOldStyle);
     std::string text, line;
     while (std::getline(in, line)) {
@@ -206,8 +206,9 @@ TEST_F(SettingsTest, BadFilesAreErrors) {
   EXPECT_THAT(ReadError(syntax), HasSubstr("YAML syntax error"));
   EXPECT_THAT(ReadError(Write("version.yaml", "File.version: \"2.0\"\n")),
               HasSubstr("File.version '2.0'"));
-  EXPECT_THAT(ReadError(Write("fisheye.yaml", "File.version: \"1.0\"\nCamera.type: \"KannalaBrandt8\"\n")),
-              HasSubstr("KannalaBrandt8"));
+  EXPECT_THAT(
+      ReadError(Write("fisheye.yaml", "File.version: \"1.0\"\nCamera.type: \"KannalaBrandt8\"\n")),
+      HasSubstr("KannalaBrandt8"));
 }
 
 TEST_F(SettingsTest, TypedGettersUseFallbackAndRejectWrongTypes) {
