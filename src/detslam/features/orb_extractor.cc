@@ -57,26 +57,46 @@ float CentroidAngle(const cv::Mat& image, cv::Point center,
   return static_cast<float>(angle);
 }
 
-// 256-bit steered BRIEF on the blurred image at `center` with orientation `angle_deg`.
+// The pattern's 512 sample points as floats: x of pair k's first point at [2k], second at [2k+1].
+struct PatternPoints {
+  std::array<float, 512> x, y;
+};
+
+PatternPoints MakePatternPoints() {
+  PatternPoints points;
+  const std::array<BriefPair, 256>& pattern = OrbPattern();
+  for (int k = 0; k < 256; ++k) {
+    points.x[2 * k] = pattern[k].x1;
+    points.y[2 * k] = pattern[k].y1;
+    points.x[2 * k + 1] = pattern[k].x2;
+    points.y[2 * k + 1] = pattern[k].y2;
+  }
+  return points;
+}
+
+// 256-bit steered BRIEF on the blurred image at `center` with orientation `angle_deg`: the pattern
+// is rotated by the angle (rounded to whole pixels, half away from zero) and bit k of the
+// descriptor (byte k / 8, bit k % 8) is I(first point) < I(second point).
 void ComputeDescriptor(const cv::Mat& blurred, cv::Point center, float angle_deg, uint8_t* out) {
+  static const PatternPoints points = MakePatternPoints();
   const double a = angle_deg * kPi / 180.0;
   const float ca = static_cast<float>(std::cos(a));
   const float sa = static_cast<float>(std::sin(a));
   const int step = static_cast<int>(blurred.step1());
+  const auto round = [](float v) { return static_cast<int>(v + (v >= 0.f ? 0.5f : -0.5f)); };
+  std::array<int, 512> offsets;  // a plain loop the compiler can vectorise
+  for (int k = 0; k < 512; ++k) {
+    const float px = points.x[k], py = points.y[k];
+    offsets[k] = round(px * sa + py * ca) * step + round(px * ca - py * sa);
+  }
   const uint8_t* c = blurred.ptr<uint8_t>(center.y) + center.x;
-  const auto sample = [&](int x, int y) {
-    const int xr = static_cast<int>(std::lround(x * ca - y * sa));
-    const int yr = static_cast<int>(std::lround(x * sa + y * ca));
-    return c[yr * step + xr];
-  };
-  const std::array<BriefPair, 256>& pattern = OrbPattern();
   for (int byte = 0; byte < 32; ++byte) {
-    uint8_t value = 0;
+    unsigned value = 0;
     for (int bit = 0; bit < 8; ++bit) {
-      const BriefPair& p = pattern[byte * 8 + bit];
-      if (sample(p.x1, p.y1) < sample(p.x2, p.y2)) value |= static_cast<uint8_t>(1u << bit);
+      const int k = 2 * (byte * 8 + bit);
+      value |= static_cast<unsigned>(c[offsets[k]] < c[offsets[k + 1]]) << bit;
     }
-    out[byte] = value;
+    out[byte] = static_cast<uint8_t>(value);
   }
 }
 
@@ -84,6 +104,64 @@ bool Masked(const cv::Mat& mask, float x, float y) {
   const int c = std::clamp(static_cast<int>(std::lround(x)), 0, mask.cols - 1);
   const int r = std::clamp(static_cast<int>(std::lround(y)), 0, mask.rows - 1);
   return mask.at<uint8_t>(r, c) != 0;
+}
+
+// FAST corners (with non-max suppression) of one level inside [kDetectBorder, size - kDetectBorder),
+// by cells of about kCellSize pixels: the whole area at ini_th_fast first, then, in each cell
+// that has no (unmasked) corner, that cell again at min_th_fast. Corners whose level-0 position
+// is masked are dropped before the per-cell decision. Positions are level pixel coordinates.
+void DetectCorners(const cv::Mat& level_image, double scale, const cv::Mat& ignore_mask,
+                   const OrbOptions& options, std::vector<cv::KeyPoint>* corners) {
+  corners->clear();
+  const int region_w = level_image.cols - 2 * kDetectBorder;
+  const int region_h = level_image.rows - 2 * kDetectBorder;
+  const int cols = std::max(1, region_w / kCellSize);
+  const int rows = std::max(1, region_h / kCellSize);
+  const double cell_w = static_cast<double>(region_w) / cols;
+  const double cell_h = static_cast<double>(region_h) / rows;
+  const auto keep = [&](const cv::KeyPoint& kp) {
+    return ignore_mask.empty() || !Masked(ignore_mask, kp.pt.x * scale, kp.pt.y * scale);
+  };
+
+  // Strong corners over the whole area (FAST cannot fire within 3 px of the area's edge).
+  constexpr int kMargin = kDetectBorder - kFastRadius;
+  std::vector<cv::KeyPoint> found;
+  cv::FAST(level_image(cv::Rect(kMargin, kMargin, level_image.cols - 2 * kMargin,
+                                level_image.rows - 2 * kMargin)),
+           found, options.ini_th_fast, true);
+  std::vector<char> cell_has_corner(cols * rows, 0);
+  for (cv::KeyPoint& kp : found) {
+    kp.pt.x += kMargin;
+    kp.pt.y += kMargin;
+    if (!keep(kp)) continue;
+    const int cx = std::clamp(static_cast<int>((kp.pt.x - kDetectBorder) / cell_w), 0, cols - 1);
+    const int cy = std::clamp(static_cast<int>((kp.pt.y - kDetectBorder) / cell_h), 0, rows - 1);
+    cell_has_corner[cy * cols + cx] = 1;
+    corners->push_back(kp);
+  }
+
+  // Cells without any: retry at the low threshold, on the cell grown by the FAST radius.
+  for (int cy = 0; cy < rows; ++cy) {
+    for (int cx = 0; cx < cols; ++cx) {
+      if (cell_has_corner[cy * cols + cx]) continue;
+      const int x_begin = kDetectBorder + static_cast<int>(std::lround(cx * cell_w));
+      const int x_end = kDetectBorder + static_cast<int>(std::lround((cx + 1) * cell_w));
+      const int y_begin = kDetectBorder + static_cast<int>(std::lround(cy * cell_h));
+      const int y_end = kDetectBorder + static_cast<int>(std::lround((cy + 1) * cell_h));
+      const cv::Rect roi(x_begin - kFastRadius, y_begin - kFastRadius,
+                         x_end - x_begin + 2 * kFastRadius, y_end - y_begin + 2 * kFastRadius);
+      found.clear();
+      cv::FAST(level_image(roi), found, options.min_th_fast, true);
+      for (cv::KeyPoint& kp : found) {
+        kp.pt.x += roi.x;
+        kp.pt.y += roi.y;
+        if (kp.pt.x < x_begin || kp.pt.x >= x_end || kp.pt.y < y_begin || kp.pt.y >= y_end) {
+          continue;
+        }
+        if (keep(kp)) corners->push_back(kp);
+      }
+    }
+  }
 }
 
 }  // namespace
@@ -170,42 +248,7 @@ void OrbExtractor::Extract(const cv::Mat& gray, const cv::Mat& ignore_mask,
     cv::copyMakeBorder(level_image, padded, kEdgeThreshold, kEdgeThreshold, kEdgeThreshold,
                        kEdgeThreshold, cv::BORDER_REFLECT_101);
 
-    // FAST once at the low threshold with non-max suppression over the detection area. A corner's
-    // FAST score does not depend on the threshold, so the corners of a cell that score at least
-    // ini_th_fast are those a run at ini_th_fast would find; cells without any fall back to all.
-    const int x0 = kDetectBorder - kFastRadius, y0 = kDetectBorder - kFastRadius;
-    const cv::Rect area(x0, y0, size.width - 2 * x0, size.height - 2 * y0);
-    candidates.clear();
-    cv::FAST(level_image(area), candidates, options_.min_th_fast, true);
-    const int region_w = size.width - 2 * kDetectBorder;
-    const int region_h = size.height - 2 * kDetectBorder;
-    const int cols = std::max(1, region_w / kCellSize);
-    const int rows = std::max(1, region_h / kCellSize);
-    const double cell_w = static_cast<double>(region_w) / cols;
-    const double cell_h = static_cast<double>(region_h) / rows;
-    std::vector<int> cell_of;
-    cell_of.reserve(candidates.size());
-    std::vector<char> cell_strong(cols * rows, 0);
-    size_t kept = 0;
-    for (cv::KeyPoint& kp : candidates) {
-      kp.pt.x += x0;
-      kp.pt.y += y0;
-      if (!ignore_mask.empty() && Masked(ignore_mask, kp.pt.x * scale, kp.pt.y * scale)) continue;
-      const int cx = std::clamp(static_cast<int>((kp.pt.x - kDetectBorder) / cell_w), 0, cols - 1);
-      const int cy = std::clamp(static_cast<int>((kp.pt.y - kDetectBorder) / cell_h), 0, rows - 1);
-      const int cell = cy * cols + cx;
-      if (kp.response >= options_.ini_th_fast) cell_strong[cell] = 1;
-      candidates[kept++] = kp;
-      cell_of.push_back(cell);
-    }
-    candidates.resize(kept);
-    size_t selected = 0;
-    for (size_t i = 0; i < candidates.size(); ++i) {
-      if (candidates[i].response >= options_.ini_th_fast || !cell_strong[cell_of[i]]) {
-        candidates[selected++] = candidates[i];
-      }
-    }
-    candidates.resize(selected);
+    DetectCorners(level_image, scale, ignore_mask, options_, &candidates);
 
     const std::vector<size_t> chosen = DistributeQuadtree(
         candidates, kDetectBorder, static_cast<float>(size.width - kDetectBorder), kDetectBorder,
