@@ -177,7 +177,11 @@ Entries LoadEntries(const std::string& path) {
   if (root.IsNull()) throw InputError(path, 0, "settings file is empty");
   if (!root.IsMap()) throw InputError(path, 0, "settings file must be a map of 'key: value'");
   Entries entries;
-  Flatten(path, root, "", &entries);
+  try {
+    Flatten(path, root, "", &entries);
+  } catch (const YAML::Exception& e) {  // e.g. a key that is itself a map or a sequence
+    throw InputError(path, e.mark.line + 1, "unsupported YAML structure: " + e.msg);
+  }
   return entries;
 }
 

@@ -204,6 +204,8 @@ TEST_F(SettingsTest, BadFilesAreErrors) {
   const std::string syntax = Write("syntax.yaml", "Camera.fx: 1\nCamera.fy: [1, 2\n");
   EXPECT_THAT(ReadError(syntax), HasSubstr(syntax + ":"));
   EXPECT_THAT(ReadError(syntax), HasSubstr("YAML syntax error"));
+  EXPECT_THAT(ReadError(Write("complex_key.yaml", "? [a, b]\n: 1\n")),
+              HasSubstr("unsupported YAML structure"));
   EXPECT_THAT(ReadError(Write("version.yaml", "File.version: \"2.0\"\n")),
               HasSubstr("File.version '2.0'"));
   EXPECT_THAT(
