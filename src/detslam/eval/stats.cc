@@ -1,0 +1,43 @@
+#include "detslam/eval/stats.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace detslam {
+
+ErrorStats ComputeErrorStats(const std::vector<double>& values) {
+  ErrorStats s;
+  s.count = values.size();
+  if (values.empty()) return s;
+  const double n = static_cast<double>(values.size());
+  double sum = 0.0, sum_sq = 0.0;
+  for (double v : values) {
+    sum += v;
+    sum_sq += v * v;
+  }
+  s.mean = sum / n;
+  s.rmse = std::sqrt(sum_sq / n);
+  double var = 0.0;
+  for (double v : values) var += (v - s.mean) * (v - s.mean);
+  s.std = std::sqrt(var / n);
+  std::vector<double> sorted = values;
+  std::sort(sorted.begin(), sorted.end());
+  const size_t mid = sorted.size() / 2;
+  s.median = sorted.size() % 2 == 1 ? sorted[mid] : 0.5 * (sorted[mid - 1] + sorted[mid]);
+  s.min = sorted.front();
+  s.max = sorted.back();
+  return s;
+}
+
+ErrorStats ScaleErrorStats(const ErrorStats& stats, double factor) {
+  ErrorStats s = stats;
+  s.rmse *= factor;
+  s.mean *= factor;
+  s.median *= factor;
+  s.std *= factor;
+  s.min *= factor;
+  s.max *= factor;
+  return s;
+}
+
+}  // namespace detslam
