@@ -1,0 +1,49 @@
+#include "detslam/map/frame.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace detslam {
+
+ImageBounds UndistortedBounds(const PinholeCamera& camera) {
+  ImageBounds b{0.0, static_cast<double>(camera.width), 0.0, static_cast<double>(camera.height)};
+  if (!camera.HasDistortion()) return b;
+  const double w = camera.width, h = camera.height;
+  const std::vector<Eigen::Vector2d> c = camera.Undistort({{0, 0}, {w, 0}, {0, h}, {w, h}});
+  b.min_x = std::min(c[0].x(), c[2].x());
+  b.max_x = std::max(c[1].x(), c[3].x());
+  b.min_y = std::min(c[0].y(), c[1].y());
+  b.max_y = std::max(c[2].y(), c[3].y());
+  return b;
+}
+
+std::shared_ptr<FrameFeatures> BuildFrameFeatures(const PinholeCamera& camera,
+                                                  std::vector<cv::KeyPoint> keypoints,
+                                                  cv::Mat descriptors, const cv::Mat& depth_m) {
+  auto f = std::make_shared<FrameFeatures>();
+  const size_t n = keypoints.size();
+  std::vector<Eigen::Vector2d> distorted(n);
+  for (size_t i = 0; i < n; ++i) distorted[i] = {keypoints[i].pt.x, keypoints[i].pt.y};
+  f->undist = camera.Undistort(distorted);
+  f->depth.assign(n, -1.0f);
+  f->u_right.assign(n, -1.0f);
+  for (size_t i = 0; i < n; ++i) {
+    const int u = static_cast<int>(std::lround(keypoints[i].pt.x));
+    const int v = static_cast<int>(std::lround(keypoints[i].pt.y));
+    if (depth_m.empty() || u < 0 || v < 0 || u >= depth_m.cols || v >= depth_m.rows) continue;
+    const float d = depth_m.at<float>(v, u);
+    if (d > 0 && std::isfinite(d)) {
+      f->depth[i] = d;
+      f->u_right[i] = static_cast<float>(f->undist[i].x() - camera.bf / d);
+    }
+  }
+  f->labels.assign(n, KeypointLabel::kStatic);
+  std::vector<int> octaves(n);
+  for (size_t i = 0; i < n; ++i) octaves[i] = keypoints[i].octave;
+  f->grid = std::make_shared<KeypointGrid>(f->undist, octaves, UndistortedBounds(camera));
+  f->keypoints = std::move(keypoints);
+  f->descriptors = std::move(descriptors);
+  return f;
+}
+
+}  // namespace detslam

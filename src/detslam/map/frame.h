@@ -1,0 +1,71 @@
+// One RGB-D frame after feature extraction: keypoints (distorted as detected, and undistorted),
+// their depth and virtual right coordinate, descriptors, a grid for area queries, and the
+// per-keypoint associations to map landmarks that tracking fills in.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <memory>
+#include <opencv2/core.hpp>
+#include <optional>
+#include <vector>
+
+#include "detslam/core/camera.h"
+#include "detslam/core/rigid3d.h"
+#include "detslam/core/timestamp.h"
+#include "detslam/features/keypoint_grid.h"
+
+namespace detslam {
+
+using LandmarkId = int64_t;
+using KeyFrameId = int64_t;
+constexpr LandmarkId kNoLandmark = -1;
+constexpr KeyFrameId kNoKeyFrame = -1;
+
+// Why a keypoint was withheld from tracking (diagnostics for the dynamic filter).
+enum class KeypointLabel : uint8_t { kStatic = 0, kDynamicMask = 1, kDynamicDepth = 2, kGeometric = 3 };
+
+// Scale pyramid facts shared by all frames of a run.
+struct ScaleInfo {
+  std::vector<double> scale_factors;     // per level: 1, s, s^2, ...
+  std::vector<double> level_sigma2;      // scale^2
+  std::vector<double> inv_level_sigma2;  // 1 / scale^2
+  double log_scale_factor = 0.0;         // log(s)
+  int num_levels() const { return static_cast<int>(scale_factors.size()); }
+};
+
+struct FrameFeatures {
+  std::vector<cv::KeyPoint> keypoints;   // as detected (distorted pixel coordinates)
+  std::vector<Eigen::Vector2d> undist;   // undistorted pixel coordinates
+  std::vector<float> depth;              // metres, <= 0 when unknown
+  std::vector<float> u_right;            // u - bf/depth, < 0 when unknown
+  cv::Mat descriptors;                   // N x 32, CV_8UC1
+  std::vector<KeypointLabel> labels;     // dynamic-filter label per keypoint (all kStatic if none)
+  std::shared_ptr<const KeypointGrid> grid;  // area queries over `undist`
+
+  size_t size() const { return keypoints.size(); }
+  const uint8_t* Descriptor(size_t i) const { return descriptors.ptr<uint8_t>(static_cast<int>(i)); }
+};
+
+struct Frame {
+  int64_t index = 0;                 // position in the input sequence
+  Timestamp stamp;
+  std::shared_ptr<const FrameFeatures> features;  // shared with the keyframe made from it
+  std::vector<LandmarkId> landmarks;  // per keypoint, kNoLandmark if none
+  std::vector<bool> outlier;          // per keypoint, set by pose optimisation
+  std::optional<Rigid3d> cam_from_world;
+  KeyFrameId reference_keyframe = kNoKeyFrame;
+
+  size_t size() const { return features ? features->size() : 0; }
+};
+
+// Bounds of undistorted keypoint positions (the image corners undistorted).
+ImageBounds UndistortedBounds(const PinholeCamera& camera);
+
+// Builds a frame's features from extraction output and the depth image (CV_32FC1, metres):
+// depth is read at the detected (distorted) pixel, as ORB-SLAM does, and keypoints are undistorted.
+std::shared_ptr<FrameFeatures> BuildFrameFeatures(const PinholeCamera& camera,
+                                                  std::vector<cv::KeyPoint> keypoints,
+                                                  cv::Mat descriptors, const cv::Mat& depth_m);
+
+}  // namespace detslam

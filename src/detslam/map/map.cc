@@ -1,0 +1,210 @@
+#include "detslam/map/map.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "detslam/core/check.h"
+#include "detslam/features/orb_extractor.h"
+
+namespace detslam {
+
+int Landmark::PredictScale(double distance, const ScaleInfo& scale) const {
+  if (distance <= 0 || max_distance <= 0) return 0;
+  const int level = static_cast<int>(std::ceil(std::log(max_distance / distance) / scale.log_scale_factor));
+  return std::clamp(level, 0, scale.num_levels() - 1);
+}
+
+KeyFrameId Map::AddKeyFrame(KeyFrame kf) {
+  kf.id = next_keyframe_id_++;
+  kf.landmarks.assign(kf.features->size(), kNoLandmark);
+  const KeyFrameId id = kf.id;
+  keyframes_.emplace(id, std::move(kf));
+  return id;
+}
+
+LandmarkId Map::AddLandmark(const Eigen::Vector3d& position, KeyFrameId reference) {
+  Landmark lm;
+  lm.id = next_landmark_id_++;
+  lm.position = position;
+  lm.reference_keyframe = reference;
+  lm.first_keyframe = reference;
+  const LandmarkId id = lm.id;
+  landmarks_.emplace(id, std::move(lm));
+  return id;
+}
+
+KeyFrame& Map::keyframe(KeyFrameId id) {
+  auto it = keyframes_.find(id);
+  DETSLAM_CHECK_MSG(it != keyframes_.end(), "no keyframe " << id);
+  return it->second;
+}
+const KeyFrame& Map::keyframe(KeyFrameId id) const {
+  auto it = keyframes_.find(id);
+  DETSLAM_CHECK_MSG(it != keyframes_.end(), "no keyframe " << id);
+  return it->second;
+}
+Landmark& Map::landmark(LandmarkId id) {
+  auto it = landmarks_.find(id);
+  DETSLAM_CHECK_MSG(it != landmarks_.end(), "no landmark " << id);
+  return it->second;
+}
+const Landmark& Map::landmark(LandmarkId id) const {
+  auto it = landmarks_.find(id);
+  DETSLAM_CHECK_MSG(it != landmarks_.end(), "no landmark " << id);
+  return it->second;
+}
+
+void Map::AddObservation(LandmarkId lm_id, KeyFrameId kf_id, size_t idx) {
+  KeyFrame& kf = keyframe(kf_id);
+  Landmark& lm = landmark(lm_id);
+  DETSLAM_CHECK(idx < kf.landmarks.size());
+  DETSLAM_CHECK_MSG(kf.landmarks[idx] == kNoLandmark, "slot " << idx << " of keyframe " << kf_id << " taken");
+  if (lm.observations.count(kf_id)) return;  // one observation per keyframe
+  lm.observations[kf_id] = idx;
+  kf.landmarks[idx] = lm_id;
+}
+
+void Map::EraseObservation(LandmarkId lm_id, KeyFrameId kf_id) {
+  Landmark& lm = landmark(lm_id);
+  auto it = lm.observations.find(kf_id);
+  if (it == lm.observations.end()) return;
+  KeyFrame& kf = keyframe(kf_id);
+  kf.landmarks[it->second] = kNoLandmark;
+  lm.observations.erase(it);
+  if (lm.observations.empty()) {
+    landmarks_.erase(lm_id);
+    return;
+  }
+  if (lm.reference_keyframe == kf_id) lm.reference_keyframe = lm.observations.begin()->first;
+}
+
+void Map::EraseLandmark(LandmarkId lm_id) {
+  auto it = landmarks_.find(lm_id);
+  if (it == landmarks_.end()) return;
+  for (const auto& [kf_id, idx] : it->second.observations) keyframes_.at(kf_id).landmarks[idx] = kNoLandmark;
+  landmarks_.erase(it);
+}
+
+void Map::ReplaceLandmark(LandmarkId from, LandmarkId into) {
+  if (from == into || !HasLandmark(from) || !HasLandmark(into)) return;
+  const std::map<KeyFrameId, size_t> obs = landmark(from).observations;
+  const int visible = landmark(from).visible, found = landmark(from).found;
+  for (const auto& [kf_id, idx] : obs) {
+    keyframes_.at(kf_id).landmarks[idx] = kNoLandmark;
+    if (!landmark(into).observations.count(kf_id)) AddObservation(into, kf_id, idx);
+  }
+  landmarks_.erase(from);
+  Landmark& target = landmark(into);
+  target.visible += visible;
+  target.found += found;
+  UpdateLandmarkDescriptor(into);
+}
+
+void Map::EraseKeyFrame(KeyFrameId kf_id) {
+  if (!HasKeyFrame(kf_id) || kf_id == first_keyframe()) return;
+  KeyFrame& kf = keyframe(kf_id);
+  const std::vector<LandmarkId> lms = kf.landmarks;
+  for (LandmarkId lm : lms) {
+    if (lm != kNoLandmark && HasLandmark(lm)) EraseObservation(lm, kf_id);
+  }
+  // Reparent children to the parent (simple, keeps a tree rooted at the first keyframe).
+  const KeyFrameId parent = kf.parent;
+  for (KeyFrameId child : kf.children) {
+    if (!HasKeyFrame(child)) continue;
+    keyframe(child).parent = parent;
+    if (HasKeyFrame(parent)) keyframe(parent).children.insert(child);
+  }
+  if (HasKeyFrame(parent)) keyframe(parent).children.erase(kf_id);
+  for (const auto& [other, w] : kf.covisibility) {
+    (void)w;
+    if (HasKeyFrame(other)) keyframe(other).covisibility.erase(kf_id);
+  }
+  keyframes_.erase(kf_id);
+}
+
+void Map::UpdateConnections(KeyFrameId kf_id) {
+  KeyFrame& kf = keyframe(kf_id);
+  std::map<KeyFrameId, int> counts;
+  for (LandmarkId lm_id : kf.landmarks) {
+    if (lm_id == kNoLandmark) continue;
+    for (const auto& [other, idx] : landmark(lm_id).observations) {
+      (void)idx;
+      if (other != kf_id) ++counts[other];
+    }
+  }
+  for (const auto& [other, w] : kf.covisibility) {
+    (void)w;
+    if (!counts.count(other) && HasKeyFrame(other)) keyframe(other).covisibility.erase(kf_id);
+  }
+  kf.covisibility = counts;
+  KeyFrameId best = kNoKeyFrame;
+  int best_w = 0;
+  for (const auto& [other, w] : counts) {
+    keyframe(other).covisibility[kf_id] = w;
+    if (w > best_w) best_w = w, best = other;
+  }
+  if (kf.parent == kNoKeyFrame && best != kNoKeyFrame && kf_id != first_keyframe()) {
+    kf.parent = best;
+    keyframe(best).children.insert(kf_id);
+  }
+}
+
+std::vector<KeyFrameId> Map::BestCovisibles(KeyFrameId kf_id, size_t n, int min_weight) const {
+  const KeyFrame& kf = keyframe(kf_id);
+  std::vector<std::pair<int, KeyFrameId>> v;
+  for (const auto& [other, w] : kf.covisibility) {
+    if (w >= min_weight) v.emplace_back(w, other);
+  }
+  std::sort(v.begin(), v.end(), [](const auto& a, const auto& b) {
+    return a.first != b.first ? a.first > b.first : a.second < b.second;
+  });
+  std::vector<KeyFrameId> out;
+  for (size_t i = 0; i < v.size() && i < n; ++i) out.push_back(v[i].second);
+  return out;
+}
+
+void Map::UpdateLandmarkGeometry(LandmarkId lm_id) {
+  Landmark& lm = landmark(lm_id);
+  if (lm.observations.empty() || !HasKeyFrame(lm.reference_keyframe)) return;
+  Eigen::Vector3d normal = Eigen::Vector3d::Zero();
+  for (const auto& [kf_id, idx] : lm.observations) {
+    (void)idx;
+    const Eigen::Vector3d dir = lm.position - keyframe(kf_id).Center();
+    if (dir.norm() > 0) normal += dir.normalized();
+  }
+  if (normal.norm() > 0) lm.normal = normal.normalized();
+  const KeyFrame& ref = keyframe(lm.reference_keyframe);
+  const double dist = (lm.position - ref.Center()).norm();
+  const int level = ref.features->keypoints[lm.observations.at(ref.id)].octave;
+  const double level_scale = scale_.scale_factors[static_cast<size_t>(level)];
+  lm.max_distance = dist * level_scale;
+  lm.min_distance = lm.max_distance / scale_.scale_factors.back();
+}
+
+void Map::UpdateLandmarkDescriptor(LandmarkId lm_id) {
+  Landmark& lm = landmark(lm_id);
+  std::vector<const uint8_t*> descs;
+  for (const auto& [kf_id, idx] : lm.observations) descs.push_back(keyframe(kf_id).features->Descriptor(idx));
+  if (descs.empty()) return;
+  size_t best = 0;
+  int best_median = std::numeric_limits<int>::max();
+  for (size_t i = 0; i < descs.size(); ++i) {
+    std::vector<int> d;
+    for (size_t j = 0; j < descs.size(); ++j) d.push_back(DescriptorDistance(descs[i], descs[j]));
+    std::sort(d.begin(), d.end());
+    const int median = d[(d.size() - 1) / 2];
+    if (median < best_median) best_median = median, best = i;
+  }
+  lm.descriptor = cv::Mat(1, 32, CV_8UC1);
+  std::copy(descs[best], descs[best] + 32, lm.descriptor.ptr<uint8_t>());
+}
+
+int Map::TrackedLandmarks(KeyFrameId kf_id, int min_obs) const {
+  int n = 0;
+  for (LandmarkId lm : keyframe(kf_id).landmarks) {
+    if (lm != kNoLandmark && static_cast<int>(landmark(lm).observations.size()) >= min_obs) ++n;
+  }
+  return n;
+}
+
+}  // namespace detslam

@@ -1,0 +1,95 @@
+// The data-only map: keyframes and landmarks owned by id, observations and covisibility by id.
+// The Map guards its own invariants: an observation exists in the landmark and in the keyframe's
+// slot at the same time, covisibility weights equal the number of shared landmarks.
+#pragma once
+
+#include <Eigen/Core>
+#include <map>
+#include <memory>
+#include <set>
+#include <unordered_map>
+#include <vector>
+
+#include "detslam/map/frame.h"
+
+namespace detslam {
+
+struct KeyFrame {
+  KeyFrameId id = kNoKeyFrame;
+  int64_t frame_index = 0;  // input frame it was made from
+  Timestamp stamp;
+  Rigid3d cam_from_world;
+  std::shared_ptr<const FrameFeatures> features;
+  std::vector<LandmarkId> landmarks;        // per keypoint
+  std::map<KeyFrameId, int> covisibility;   // neighbour -> shared landmarks (>= 1)
+  KeyFrameId parent = kNoKeyFrame;          // spanning tree
+  std::set<KeyFrameId> children;
+
+  Eigen::Vector3d Center() const { return cam_from_world.Inverse().translation(); }
+  size_t size() const { return landmarks.size(); }
+};
+
+struct Landmark {
+  LandmarkId id = kNoLandmark;
+  Eigen::Vector3d position;                     // in the world frame
+  std::map<KeyFrameId, size_t> observations;    // keyframe -> keypoint index
+  cv::Mat descriptor;                           // 1 x 32, most representative observation
+  Eigen::Vector3d normal = Eigen::Vector3d::Zero();  // mean viewing direction
+  double min_distance = 0.0, max_distance = 0.0;     // scale-invariance distance bounds
+  KeyFrameId reference_keyframe = kNoKeyFrame;
+  KeyFrameId first_keyframe = kNoKeyFrame;
+  int visible = 1;  // times it was predicted to be seen in a tracked frame
+  int found = 1;    // times it was actually matched
+
+  double FoundRatio() const { return static_cast<double>(found) / std::max(visible, 1); }
+  // Predicted pyramid level from the distance to the camera.
+  int PredictScale(double distance, const ScaleInfo& scale) const;
+};
+
+class Map {
+ public:
+  explicit Map(ScaleInfo scale) : scale_(std::move(scale)) {}
+
+  KeyFrameId AddKeyFrame(KeyFrame kf);  // assigns the id; landmarks vector must be all kNoLandmark
+  LandmarkId AddLandmark(const Eigen::Vector3d& position, KeyFrameId reference);
+  // Links landmark `lm` to keypoint `idx` of keyframe `kf` (both must exist, slot must be free).
+  void AddObservation(LandmarkId lm, KeyFrameId kf, size_t idx);
+  void EraseObservation(LandmarkId lm, KeyFrameId kf);
+  void EraseLandmark(LandmarkId lm);
+  void EraseKeyFrame(KeyFrameId kf);  // reparents children, removes observations
+  // Merges `from` into `into` (all observations move; duplicates in one keyframe are dropped).
+  void ReplaceLandmark(LandmarkId from, LandmarkId into);
+
+  // Recomputes covisibility edges of `kf` (and the reciprocal ones) from shared landmarks and
+  // sets its parent to the neighbour with most shared points if it has none.
+  void UpdateConnections(KeyFrameId kf);
+  // Recomputes normal, distance bounds and representative descriptor of a landmark.
+  void UpdateLandmarkGeometry(LandmarkId lm);
+  void UpdateLandmarkDescriptor(LandmarkId lm);
+
+  std::vector<KeyFrameId> BestCovisibles(KeyFrameId kf, size_t n, int min_weight = 0) const;
+
+  bool HasKeyFrame(KeyFrameId id) const { return keyframes_.count(id) > 0; }
+  bool HasLandmark(LandmarkId id) const { return landmarks_.count(id) > 0; }
+  KeyFrame& keyframe(KeyFrameId id);
+  const KeyFrame& keyframe(KeyFrameId id) const;
+  Landmark& landmark(LandmarkId id);
+  const Landmark& landmark(LandmarkId id) const;
+  const std::map<KeyFrameId, KeyFrame>& keyframes() const { return keyframes_; }
+  const std::map<LandmarkId, Landmark>& landmarks() const { return landmarks_; }
+  size_t NumKeyFrames() const { return keyframes_.size(); }
+  size_t NumLandmarks() const { return landmarks_.size(); }
+  const ScaleInfo& scale() const { return scale_; }
+  KeyFrameId first_keyframe() const { return keyframes_.empty() ? kNoKeyFrame : keyframes_.begin()->first; }
+  // Number of landmarks of `kf` observed by at least `min_obs` keyframes.
+  int TrackedLandmarks(KeyFrameId kf, int min_obs) const;
+
+ private:
+  ScaleInfo scale_;
+  std::map<KeyFrameId, KeyFrame> keyframes_;  // ordered: deterministic iteration
+  std::map<LandmarkId, Landmark> landmarks_;
+  KeyFrameId next_keyframe_id_ = 0;
+  LandmarkId next_landmark_id_ = 0;
+};
+
+}  // namespace detslam
