@@ -4,12 +4,11 @@
 #include <benchmark/benchmark.h>
 
 #include <cstdlib>
-#include <string>
-#include <vector>
-
 #include <opencv2/core.hpp>
 #include <opencv2/core/utility.hpp>
 #include <opencv2/imgcodecs.hpp>
+#include <string>
+#include <vector>
 
 #include "detslam/features/matcher.h"
 #include "detslam/features/orb_extractor.h"

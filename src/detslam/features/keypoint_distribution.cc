@@ -45,8 +45,11 @@ std::vector<size_t> DistributeQuadtree(const std::vector<cv::KeyPoint>& keypoint
   const float width = (max_x - min_x) / num_initial;
   std::vector<Node> nodes(num_initial);
   for (int i = 0; i < num_initial; ++i) {
-    nodes[i] = {min_x + i * width, i + 1 == num_initial ? max_x : min_x + (i + 1) * width, min_y,
-                max_y, {}};
+    nodes[i] = {min_x + i * width,
+                i + 1 == num_initial ? max_x : min_x + (i + 1) * width,
+                min_y,
+                max_y,
+                {}};
   }
   for (size_t i = 0; i < keypoints.size(); ++i) {
     const cv::Point2f& p = keypoints[i].pt;
@@ -54,9 +57,9 @@ std::vector<size_t> DistributeQuadtree(const std::vector<cv::KeyPoint>& keypoint
     const int n = std::min(num_initial - 1, static_cast<int>((p.x - min_x) / width));
     nodes[n].indices.push_back(i);
   }
-  nodes.erase(std::remove_if(nodes.begin(), nodes.end(),
-                             [](const Node& n) { return n.indices.empty(); }),
-              nodes.end());
+  nodes.erase(
+      std::remove_if(nodes.begin(), nodes.end(), [](const Node& n) { return n.indices.empty(); }),
+      nodes.end());
 
   const size_t wanted = static_cast<size_t>(target);
   while (nodes.size() < wanted) {

@@ -32,8 +32,8 @@ bool KeypointGrid::CellOf(double x, double y, int* col, int* row) const {
   return true;
 }
 
-std::vector<size_t> KeypointGrid::FeaturesInArea(double x, double y, double radius,
-                                                 int min_level, int max_level) const {
+std::vector<size_t> KeypointGrid::FeaturesInArea(double x, double y, double radius, int min_level,
+                                                 int max_level) const {
   std::vector<size_t> result;
   if (cells_.empty() || !(radius > 0)) return result;
   const int col0 = static_cast<int>(std::floor((x - radius - bounds_.min_x) * inv_cell_w_));

@@ -2,10 +2,9 @@
 // projection searches of tracking and mapping, like ORB-SLAM's Frame::GetFeaturesInArea).
 #pragma once
 
+#include <Eigen/Core>
 #include <cstddef>
 #include <vector>
-
-#include <Eigen/Core>
 
 namespace detslam {
 

@@ -11,8 +11,8 @@ namespace detslam {
 namespace {
 
 std::vector<size_t> BruteForce(const std::vector<Eigen::Vector2d>& positions,
-                               const std::vector<int>& octaves, const ImageBounds& bounds,
-                               double x, double y, double r, int min_level, int max_level) {
+                               const std::vector<int>& octaves, const ImageBounds& bounds, double x,
+                               double y, double r, int min_level, int max_level) {
   std::vector<size_t> result;
   for (size_t i = 0; i < positions.size(); ++i) {
     const Eigen::Vector2d& p = positions[i];
@@ -56,8 +56,8 @@ TEST(KeypointGridTest, QueriesEqualBruteForce) {
 }
 
 TEST(KeypointGridTest, HandMadeWindowIsSquareAndStrict) {
-  const std::vector<Eigen::Vector2d> positions = {
-      {100, 100}, {109.9, 100}, {110, 100}, {109, 109}, {90.5, 91}, {300, 300}};
+  const std::vector<Eigen::Vector2d> positions = {{100, 100}, {109.9, 100}, {110, 100},
+                                                  {109, 109}, {90.5, 91},   {300, 300}};
   const std::vector<int> octaves = {0, 1, 0, 2, 3, 0};
   const KeypointGrid grid(positions, octaves, ImageBounds{});
   // |dx| < 10 and |dy| < 10: (110, 100) is exactly on the edge and excluded, the corner (109, 109)

@@ -13,9 +13,9 @@ std::vector<cv::DMatch> MatchBruteForce(const std::vector<cv::KeyPoint>& kp_a,
                                         const cv::Mat& desc_a,
                                         const std::vector<cv::KeyPoint>& kp_b,
                                         const cv::Mat& desc_b, const MatchOptions& options) {
-  DETSLAM_CHECK_MSG(desc_a.rows == static_cast<int>(kp_a.size()) &&
-                        desc_b.rows == static_cast<int>(kp_b.size()),
-                    "descriptor rows must equal keypoint counts");
+  DETSLAM_CHECK_MSG(
+      desc_a.rows == static_cast<int>(kp_a.size()) && desc_b.rows == static_cast<int>(kp_b.size()),
+      "descriptor rows must equal keypoint counts");
   std::vector<cv::DMatch> matches;
   if (kp_a.empty() || kp_b.empty()) return matches;
   DETSLAM_CHECK(desc_a.type() == CV_8UC1 && desc_a.cols == 32 && desc_b.type() == CV_8UC1 &&
@@ -89,8 +89,7 @@ std::vector<bool> RotationConsistency(const std::vector<float>& angle_difference
   // The three most populated bins (stable: lower bin first on ties).
   std::vector<int> order(bins);
   for (int b = 0; b < bins; ++b) order[b] = b;
-  std::stable_sort(order.begin(), order.end(),
-                   [&](int a, int b) { return counts[a] > counts[b]; });
+  std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return counts[a] > counts[b]; });
   std::vector<bool> bin_kept(bins, false);
   const int max_count = counts[order[0]];
   for (int k = 0; k < std::min(3, bins); ++k) {

@@ -2,10 +2,9 @@
 // rotation-consistency check shared by all of ORB-SLAM's matchers.
 #pragma once
 
-#include <vector>
-
 #include <opencv2/core.hpp>
 #include <opencv2/core/types.hpp>
+#include <vector>
 
 namespace detslam {
 

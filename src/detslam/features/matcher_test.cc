@@ -12,10 +12,10 @@ namespace {
 
 TEST(RotationConsistencyTest, KeepsThreeLargestBinsAboveTenPercent) {
   std::vector<float> diffs;
-  for (int i = 0; i < 50; ++i) diffs.push_back(15.f);   // bin 1 (12 deg bins)
-  for (int i = 0; i < 20; ++i) diffs.push_back(-5.f);   // wraps to 355: bin 29
-  for (int i = 0; i < 6; ++i) diffs.push_back(100.f);   // bin 8: third, 12% of max: kept
-  for (int i = 0; i < 3; ++i) diffs.push_back(200.f);   // bin 16: fourth: dropped
+  for (int i = 0; i < 50; ++i) diffs.push_back(15.f);  // bin 1 (12 deg bins)
+  for (int i = 0; i < 20; ++i) diffs.push_back(-5.f);  // wraps to 355: bin 29
+  for (int i = 0; i < 6; ++i) diffs.push_back(100.f);  // bin 8: third, 12% of max: kept
+  for (int i = 0; i < 3; ++i) diffs.push_back(200.f);  // bin 16: fourth: dropped
   const std::vector<bool> keep = RotationConsistency(diffs);
   ASSERT_EQ(keep.size(), diffs.size());
   for (size_t i = 0; i < diffs.size(); ++i) EXPECT_EQ(keep[i], i < 76) << i;
@@ -23,7 +23,7 @@ TEST(RotationConsistencyTest, KeepsThreeLargestBinsAboveTenPercent) {
 
 TEST(RotationConsistencyTest, DropsSmallSecondAndThirdBins) {
   std::vector<float> diffs(100, 181.f);
-  diffs.push_back(10.f);                         // 1 < 10% of 100: dropped
+  diffs.push_back(10.f);                               // 1 < 10% of 100: dropped
   for (int i = 0; i < 9; ++i) diffs.push_back(725.f);  // 725 = 5 (mod 360): bin 0, 10 entries
   const std::vector<bool> keep = RotationConsistency(diffs);
   for (size_t i = 0; i < 100; ++i) EXPECT_TRUE(keep[i]);
@@ -46,7 +46,8 @@ TEST(MatchBruteForceTest, RatioDistanceAndOneToOne) {
   Rng rng(5);
   cv::Mat a0(1, 32, CV_8UC1), a1(1, 32, CV_8UC1), a2(1, 32, CV_8UC1);
   for (cv::Mat* m : {&a0, &a1, &a2}) {
-    for (int i = 0; i < 32; ++i) m->at<uint8_t>(0, i) = static_cast<uint8_t>(rng.UniformInt(0, 255));
+    for (int i = 0; i < 32; ++i)
+      m->at<uint8_t>(0, i) = static_cast<uint8_t>(rng.UniformInt(0, 255));
   }
   cv::Mat desc_a, desc_b;
   cv::vconcat(std::vector<cv::Mat>{a0, a1, a2, Flipped(a0, 0, 6)}, desc_a);
@@ -56,7 +57,8 @@ TEST(MatchBruteForceTest, RatioDistanceAndOneToOne) {
                                    Flipped(a2, 0, 60)},
               desc_b);
   ASSERT_EQ(DescriptorDistance(desc_a.ptr(3), desc_b.ptr(0)), 11);
-  std::vector<cv::KeyPoint> kp_a(4, cv::KeyPoint(0, 0, 31, 10.f)), kp_b(4, cv::KeyPoint(0, 0, 31, 10.f));
+  std::vector<cv::KeyPoint> kp_a(4, cv::KeyPoint(0, 0, 31, 10.f)),
+      kp_b(4, cv::KeyPoint(0, 0, 31, 10.f));
   MatchOptions options;
   options.check_orientation = false;
   std::vector<cv::DMatch> m = MatchBruteForce(kp_a, desc_a, kp_b, desc_b, options);
@@ -66,7 +68,7 @@ TEST(MatchBruteForceTest, RatioDistanceAndOneToOne) {
   EXPECT_EQ(m[0].trainIdx, 0);
   EXPECT_EQ(m[0].distance, 5.f);
 
-  options.ratio = 0.95;        // a1 -> b1 now passes (30 < 0.95 * 32)
+  options.ratio = 0.95;            // a1 -> b1 now passes (30 < 0.95 * 32)
   options.max_distance = kThHigh;  // a2 -> b3 (60) now passes
   m = MatchBruteForce(kp_a, desc_a, kp_b, desc_b, options);
   ASSERT_EQ(m.size(), 3u);
@@ -82,7 +84,8 @@ TEST(MatchBruteForceTest, OrientationCheckRemovesInconsistentRotation) {
   const int n = 40;
   cv::Mat desc(n, 32, CV_8UC1);
   for (int r = 0; r < n; ++r) {
-    for (int i = 0; i < 32; ++i) desc.at<uint8_t>(r, i) = static_cast<uint8_t>(rng.UniformInt(0, 255));
+    for (int i = 0; i < 32; ++i)
+      desc.at<uint8_t>(r, i) = static_cast<uint8_t>(rng.UniformInt(0, 255));
   }
   std::vector<cv::KeyPoint> kp_a, kp_b;
   for (int r = 0; r < n; ++r) {

@@ -4,10 +4,9 @@
 #include <array>
 #include <cmath>
 #include <cstring>
-#include <sstream>
-
 #include <opencv2/features2d.hpp>
 #include <opencv2/imgproc.hpp>
+#include <sstream>
 
 #include "detslam/core/check.h"
 #include "detslam/features/keypoint_distribution.h"
@@ -18,10 +17,10 @@ namespace {
 
 constexpr int kPatchSize = 31;
 constexpr int kHalfPatch = 15;
-constexpr int kEdgeThreshold = 19;           // border added around each level image
+constexpr int kEdgeThreshold = 19;                 // border added around each level image
 constexpr int kDetectBorder = kEdgeThreshold - 3;  // keypoints lie at least this far inside
-constexpr int kCellSize = 35;                // FAST threshold cells (ORB-SLAM's W)
-constexpr int kFastRadius = 3;               // FAST needs this many pixels around a candidate
+constexpr int kCellSize = 35;                      // FAST threshold cells (ORB-SLAM's W)
+constexpr int kFastRadius = 3;                     // FAST needs this many pixels around a candidate
 constexpr double kPi = 3.14159265358979323846;
 
 // Half-widths of the radius-15 circular patch, per row offset 0..15: u^2 + v^2 <= 15^2.
@@ -106,10 +105,11 @@ bool Masked(const cv::Mat& mask, float x, float y) {
   return mask.at<uint8_t>(r, c) != 0;
 }
 
-// FAST corners (with non-max suppression) of one level inside [kDetectBorder, size - kDetectBorder),
-// by cells of about kCellSize pixels: the whole area at ini_th_fast first, then, in each cell
-// that has no (unmasked) corner, that cell again at min_th_fast. Corners whose level-0 position
-// is masked are dropped before the per-cell decision. Positions are level pixel coordinates.
+// FAST corners (with non-max suppression) of one level inside [kDetectBorder, size -
+// kDetectBorder), by cells of about kCellSize pixels: the whole area at ini_th_fast first, then, in
+// each cell that has no (unmasked) corner, that cell again at min_th_fast. Corners whose level-0
+// position is masked are dropped before the per-cell decision. Positions are level pixel
+// coordinates.
 void DetectCorners(const cv::Mat& level_image, double scale, const cv::Mat& ignore_mask,
                    const OrbOptions& options, std::vector<cv::KeyPoint>* corners) {
   corners->clear();
@@ -219,7 +219,8 @@ void OrbExtractor::Extract(const cv::Mat& gray, const cv::Mat& ignore_mask,
   if (gray.empty() || gray.type() != CV_8UC1) {
     throw InputError("OrbExtractor::Extract: image must be a non-empty CV_8UC1 image");
   }
-  if (!ignore_mask.empty() && (ignore_mask.type() != CV_8UC1 || ignore_mask.size() != gray.size())) {
+  if (!ignore_mask.empty() &&
+      (ignore_mask.type() != CV_8UC1 || ignore_mask.size() != gray.size())) {
     throw InputError("OrbExtractor::Extract: ignore_mask must be empty or CV_8UC1 of image size");
   }
   keypoints->clear();

@@ -5,9 +5,8 @@
 #include <algorithm>
 #include <cmath>
 #include <numeric>
-#include <vector>
-
 #include <opencv2/imgproc.hpp>
+#include <vector>
 
 #include "detslam/core/check.h"
 #include "detslam/features/orb_pattern.h"

@@ -3,10 +3,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <vector>
-
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <vector>
 
 #include "detslam/features/matcher.h"
 #include "detslam/features/orb_extractor.h"
@@ -47,10 +46,10 @@ WarpMatchStats WarpAndMatch(const cv::Mat& image, double angle_deg, double scale
   stats.matches = matches.size();
   for (const cv::DMatch& m : matches) {
     const cv::Point2f& p = kp_a[m.queryIdx].pt;
-    const double x = affine.at<double>(0, 0) * p.x + affine.at<double>(0, 1) * p.y +
-                     affine.at<double>(0, 2);
-    const double y = affine.at<double>(1, 0) * p.x + affine.at<double>(1, 1) * p.y +
-                     affine.at<double>(1, 2);
+    const double x =
+        affine.at<double>(0, 0) * p.x + affine.at<double>(0, 1) * p.y + affine.at<double>(0, 2);
+    const double y =
+        affine.at<double>(1, 0) * p.x + affine.at<double>(1, 1) * p.y + affine.at<double>(1, 2);
     const cv::Point2f& q = kp_b[m.trainIdx].pt;
     if (std::hypot(q.x - x, q.y - y) <= 3.0) ++stats.correct;
   }

@@ -15,7 +15,9 @@ class SplitMix64 {
     return z ^ (z >> 31);
   }
   // Uniform in (0, 1): 53 random bits, never exactly 0.
-  double Uniform() { return (static_cast<double>(Next() >> 11) + 0.5) * (1.0 / 9007199254740992.0); }
+  double Uniform() {
+    return (static_cast<double>(Next() >> 11) + 0.5) * (1.0 / 9007199254740992.0);
+  }
 
  private:
   uint64_t state_;

@@ -3,7 +3,6 @@
 #pragma once
 
 #include <cstdint>
-
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 
