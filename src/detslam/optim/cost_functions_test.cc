@@ -1,0 +1,95 @@
+#include "detslam/optim/cost_functions.h"
+
+#include <ceres/gradient_checker.h>
+#include <ceres/manifold.h>
+#include <gtest/gtest.h>
+
+#include <memory>
+
+namespace detslam {
+namespace {
+
+StereoIntrinsics HandIntrinsics() { return {500.0, 400.0, 320.0, 240.0, 40.0}; }
+
+// cam_from_world: 90 deg about z, then + (0.1, 0, 1). World (-0.1, -0.2, 1) -> camera (0.3, -0.1, 2)
+// -> u = 500 * 0.15 + 320 = 395, v = 400 * -0.05 + 240 = 220, u_right = 395 - 40 / 2 = 375.
+const double kQ[4] = {0.0, 0.0, std::sqrt(0.5), std::sqrt(0.5)};
+const double kT[3] = {0.1, 0.0, 1.0};
+const double kP[3] = {-0.1, -0.2, 1.0};
+
+TEST(CostFunctionsTest, StereoResidualHandMade) {
+  std::unique_ptr<ceres::CostFunction> cost(
+      StereoReprojectionCost::Create(HandIntrinsics(), Eigen::Vector3d(394, 221, 372), 2.0));
+  const double* params[] = {kQ, kT, kP};
+  double r[3];
+  ASSERT_TRUE(cost->Evaluate(params, r, nullptr));
+  EXPECT_NEAR(r[0], 2.0 * (395 - 394), 1e-12);
+  EXPECT_NEAR(r[1], 2.0 * (220 - 221), 1e-12);
+  EXPECT_NEAR(r[2], 2.0 * (375 - 372), 1e-12);
+}
+
+TEST(CostFunctionsTest, MonoResidualHandMade) {
+  std::unique_ptr<ceres::CostFunction> cost(
+      MonoReprojectionCost::Create(HandIntrinsics(), Eigen::Vector2d(390, 230), 0.5));
+  const double* params[] = {kQ, kT, kP};
+  double r[2];
+  ASSERT_TRUE(cost->Evaluate(params, r, nullptr));
+  EXPECT_EQ(cost->num_residuals(), 2);
+  EXPECT_NEAR(r[0], 0.5 * 5.0, 1e-12);
+  EXPECT_NEAR(r[1], 0.5 * -10.0, 1e-12);
+}
+
+TEST(CostFunctionsTest, PoseOnlyResidualsHandMade) {
+  const Eigen::Vector3d p(kP[0], kP[1], kP[2]);
+  std::unique_ptr<ceres::CostFunction> stereo(
+      PoseOnlyStereoCost::Create(HandIntrinsics(), Eigen::Vector3d(395, 220, 376), p, 1.0));
+  std::unique_ptr<ceres::CostFunction> mono(
+      PoseOnlyMonoCost::Create(HandIntrinsics(), Eigen::Vector2d(396, 218), p, 3.0));
+  const double* params[] = {kQ, kT};
+  double rs[3], rm[2];
+  ASSERT_TRUE(stereo->Evaluate(params, rs, nullptr));
+  ASSERT_TRUE(mono->Evaluate(params, rm, nullptr));
+  EXPECT_NEAR(rs[0], 0.0, 1e-12);
+  EXPECT_NEAR(rs[1], 0.0, 1e-12);
+  EXPECT_NEAR(rs[2], -1.0, 1e-12);
+  EXPECT_NEAR(rm[0], -3.0, 1e-12);
+  EXPECT_NEAR(rm[1], 6.0, 1e-12);
+}
+
+// Probes the Jacobians (in the quaternion's tangent space) against numeric differentiation at a
+// generic, non-symmetric configuration.
+void ExpectGradientsMatch(const ceres::CostFunction& cost, int num_blocks) {
+  const Eigen::Quaterniond rot =
+      Eigen::Quaterniond(Eigen::AngleAxisd(0.4, Eigen::Vector3d(0.3, -0.5, 0.8).normalized()));
+  const double q[4] = {rot.x(), rot.y(), rot.z(), rot.w()};
+  const double t[3] = {0.2, -0.1, 0.7};
+  const double p[3] = {0.5, 0.3, 2.5};
+  const double* params[] = {q, t, p};
+  ceres::EigenQuaternionManifold quaternion;
+  std::vector<const ceres::Manifold*> manifolds(num_blocks, nullptr);
+  manifolds[0] = &quaternion;
+  ceres::NumericDiffOptions numeric;
+  const ceres::GradientChecker checker(&cost, &manifolds, numeric);
+  ceres::GradientChecker::ProbeResults results;
+  EXPECT_TRUE(checker.Probe(params, 1e-7, &results)) << results.error_log;
+  EXPECT_LT(results.maximum_relative_error, 1e-7);
+}
+
+TEST(CostFunctionsTest, GradientCheckerAcceptsAllResiduals) {
+  const Eigen::Vector3d p(0.5, 0.3, 2.5);
+  std::unique_ptr<ceres::CostFunction> c1(
+      StereoReprojectionCost::Create(HandIntrinsics(), Eigen::Vector3d(400, 250, 390), 1.7));
+  std::unique_ptr<ceres::CostFunction> c2(
+      MonoReprojectionCost::Create(HandIntrinsics(), Eigen::Vector2d(400, 250), 0.8));
+  std::unique_ptr<ceres::CostFunction> c3(
+      PoseOnlyStereoCost::Create(HandIntrinsics(), Eigen::Vector3d(400, 250, 390), p, 1.2));
+  std::unique_ptr<ceres::CostFunction> c4(
+      PoseOnlyMonoCost::Create(HandIntrinsics(), Eigen::Vector2d(400, 250), p, 1.0));
+  ExpectGradientsMatch(*c1, 3);
+  ExpectGradientsMatch(*c2, 3);
+  ExpectGradientsMatch(*c3, 2);
+  ExpectGradientsMatch(*c4, 2);
+}
+
+}  // namespace
+}  // namespace detslam
