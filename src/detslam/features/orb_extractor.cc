@@ -280,6 +280,11 @@ void OrbExtractor::Extract(const cv::Mat& gray, const cv::Mat& ignore_mask,
   }
 }
 
+// On x86-64 GCC/Clang build a POPCNT variant next to the portable one and pick at load time
+// (the default build targets plain x86-64, where __builtin_popcountll is a library call).
+#if defined(__x86_64__) && defined(__GNUC__) && defined(__linux__)
+__attribute__((target_clones("popcnt", "default")))
+#endif
 int DescriptorDistance(const uint8_t* a, const uint8_t* b) {
   int distance = 0;
   for (int i = 0; i < 32; i += 8) {
