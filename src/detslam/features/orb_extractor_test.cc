@@ -5,8 +5,8 @@
 #include <algorithm>
 #include <cmath>
 #include <numeric>
-#include <string>
 #include <opencv2/imgproc.hpp>
+#include <string>
 #include <vector>
 
 #include "detslam/core/check.h"
@@ -111,6 +111,32 @@ TEST(OrbExtractorTest, KeypointsSpreadOverImageAndFieldsValid) {
   for (int r = 0; r < 4; ++r) {
     for (int c = 0; c < 4; ++c) EXPECT_GE(cells[r][c], 25) << "cell " << r << "," << c;
   }
+}
+
+TEST(OrbExtractorTest, LowContrastCellsFallBackToMinThreshold) {
+  // Left half: full-contrast texture. Right half: the same texture squeezed to +-8 grey levels,
+  // where FAST at 20 finds nothing but FAST at 7 does.
+  cv::Mat image = MakeTexture(640, 480, 6);
+  cv::Mat right = image(cv::Rect(320, 0, 320, 480));
+  right.convertTo(right, CV_8UC1, 16.0 / 255.0, 120.0);
+  const auto count_right = [](const std::vector<cv::KeyPoint>& kps) {
+    return std::count_if(kps.begin(), kps.end(),
+                         [](const cv::KeyPoint& kp) { return kp.pt.x > 340; });
+  };
+  const Extraction with_fallback = Extract(image);
+  OrbOptions no_fallback;
+  no_fallback.min_th_fast = no_fallback.ini_th_fast;
+  const Extraction without = Extract(image, cv::Mat(), no_fallback);
+  EXPECT_EQ(count_right(without.keypoints), 0);
+  EXPECT_GT(count_right(with_fallback.keypoints), 50);  // measured 97
+}
+
+TEST(OrbExtractorTest, TinyImageGivesNoKeypoints) {
+  std::vector<cv::KeyPoint> kps(3);
+  cv::Mat desc;
+  OrbExtractor(OrbOptions()).Extract(MakeTexture(30, 30, 1), cv::Mat(), &kps, &desc);
+  EXPECT_TRUE(kps.empty());
+  EXPECT_EQ(desc.rows, 0);
 }
 
 TEST(OrbExtractorTest, PerLevelCountsFollowGeometricSeries) {
