@@ -1,12 +1,58 @@
-// detslam synth: placeholder until the synth module lands (exits 2 and says so).
+// detslam synth: writes a synthetic dynamic RGB-D sequence (TUM layout, ground-truth poses and
+// per-frame masks of the moving people); see src/detslam/synth/writer.h for the files.
+#include <nlohmann/json.hpp>
+
 #include "commands.h"
+#include "detslam/core/atomic_file.h"
+#include "detslam/core/check.h"
+#include "detslam/synth/options.h"
+#include "detslam/synth/writer.h"
 
 namespace detslam::app {
 
 void AddSynthCommand(CLI::App& app) {
-  auto* cmd = app.add_subcommand("synth", "(not implemented yet)");
-  cmd->allow_extras();
-  cmd->callback([] { throw CommandFailed("'detslam synth' is not implemented yet", 2); });
+  auto* cmd = app.add_subcommand("synth", "Write a synthetic dynamic RGB-D sequence (TUM layout)");
+  auto opts = std::make_shared<SynthOptions>();
+  auto out_dir = std::make_shared<std::string>();
+  auto stats_json = std::make_shared<std::string>();
+  auto no_people = std::make_shared<bool>(false);
+  std::string presets;
+  for (const auto& p : SynthPresetNames()) presets += (presets.empty() ? "" : ", ") + p;
+  cmd->add_option("--preset", opts->preset, "Camera/people script: " + presets)
+      ->capture_default_str();
+  cmd->add_option("--seed", opts->seed, "Seed of textures, people and sensor noise")
+      ->capture_default_str();
+  cmd->add_option("--frames", opts->frames, "Number of frames (default: the preset's length)");
+  cmd->add_option("--people", opts->people_dir,
+                  "Folder of RGBA person cut-outs (*.png, alpha = silhouette) to texture people");
+  cmd->add_flag("--no-people", *no_people, "Static twin: same camera path, no moving people");
+  cmd->add_flag("--blur", opts->motion_blur, "Motion blur from the camera velocity");
+  cmd->add_option("--out", *out_dir, "Output folder")->required();
+  cmd->add_option("--stats-json", *stats_json,
+                  "Write timing and content statistics (fps, FAST corners, coverage) as JSON");
+  cmd->callback([opts, out_dir, stats_json, no_people] {
+    opts->people = !*no_people;
+    RequireSynthPreset(opts->preset);
+    std::string error;
+    if (!opts->Check(&error)) throw InputError("detslam synth: " + error);
+    const SynthStats s = WriteSequence(*opts, *out_dir);
+    if (!stats_json->empty()) {
+      nlohmann::json j = {{"preset", opts->preset},
+                          {"seed", opts->seed},
+                          {"people", opts->people},
+                          {"people_dir", opts->people_dir},
+                          {"motion_blur", opts->motion_blur},
+                          {"frames", s.frames},
+                          {"render_seconds", s.render_seconds},
+                          {"total_seconds", s.total_seconds},
+                          {"render_fps", s.render_fps},
+                          {"total_fps", s.total_fps},
+                          {"mean_fast20_corners", s.mean_fast_corners},
+                          {"fast_sampled_frames", s.sampled_frames},
+                          {"mean_people_coverage", s.mean_coverage}};
+      WriteFileAtomically(*stats_json, [&](std::ostream& os) { os << j.dump(2) << "\n"; });
+    }
+  });
 }
 
 }  // namespace detslam::app

@@ -1,0 +1,109 @@
+#include "detslam/synth/camera_path.h"
+
+#include <cmath>
+
+#include "detslam/core/check.h"
+#include "detslam/core/rng.h"
+#include "detslam/synth/options.h"
+
+namespace detslam::synth {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kDeg = kPi / 180.0;
+
+// A sinusoid of amplitude `a` and period `period` seconds with phase `phase`.
+double Wave(double t, double a, double period, double phase) {
+  return a * std::sin(2.0 * kPi * t / period + phase);
+}
+
+}  // namespace
+
+Eigen::Matrix3d LookAtRotation(const Eigen::Vector3d& position, const Eigen::Vector3d& target) {
+  const Eigen::Vector3d z = (target - position).normalized();
+  const Eigen::Vector3d x = z.cross(Eigen::Vector3d::UnitZ()).normalized();
+  const Eigen::Vector3d y = z.cross(x);
+  Eigen::Matrix3d r;
+  r.col(0) = x;
+  r.col(1) = y;
+  r.col(2) = z;
+  return r;
+}
+
+Eigen::Matrix3d YawPitchRollRotation(double yaw, double pitch_down, double roll) {
+  Eigen::Matrix3d base;  // camera looking along world +y, image down = world -z
+  base << 1, 0, 0, 0, 0, 1, 0, -1, 0;
+  return Eigen::Matrix3d(Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ())) * base *
+         Eigen::Matrix3d(Eigen::AngleAxisd(-pitch_down, Eigen::Vector3d::UnitX())) *
+         Eigen::Matrix3d(Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitZ()));
+}
+
+CameraPath::CameraPath(const std::string& preset, uint64_t seed) : preset_(preset) {
+  RequireSynthPreset(preset);
+  Rng rng(seed ^ 0xCA3E7AULL);
+  for (double& p : phase_) p = rng.Uniform(0.0, 2.0 * kPi);
+}
+
+Rigid3d CameraPath::WorldFromCam(double t) const {
+  const double* ph = phase_;
+  const Eigen::Vector3d base(0.0, -1.6, 1.3);
+  if (preset_ == "static" || preset_ == "walking_xyz") {
+    // About +-0.5 m along each axis, peak speed ~0.4 m/s, a few degrees of wobble.
+    const Eigen::Vector3d p =
+        base + Eigen::Vector3d(Wave(t, 0.42, 10.0, ph[0]) + Wave(t, 0.08, 3.7, ph[1]),
+                               Wave(t, 0.30, 13.0, ph[2]) + Wave(t, 0.06, 4.3, ph[3]),
+                               Wave(t, 0.28, 8.0, ph[4]) + Wave(t, 0.05, 2.9, ph[5]));
+    const Eigen::Matrix3d r = YawPitchRollRotation(
+        Wave(t, 4 * kDeg, 9.0, ph[6]), 8 * kDeg + Wave(t, 3 * kDeg, 7.0, ph[7]),
+        Wave(t, 2 * kDeg, 6.0, ph[1]));
+    return Rigid3d(r, p);
+  }
+  if (preset_ == "walking_static" || preset_ == "sitting_static") {
+    // A hand-held but nearly still camera: millimetres and fractions of a degree.
+    const Eigen::Vector3d b = preset_ == "sitting_static" ? Eigen::Vector3d(0.0, -0.25, 1.25) : base;
+    const Eigen::Vector3d p =
+        b + Eigen::Vector3d(Wave(t, 0.008, 3.1, ph[0]) + Wave(t, 0.003, 0.9, ph[1]),
+                            Wave(t, 0.006, 4.7, ph[2]), Wave(t, 0.007, 2.3, ph[3]));
+    const Eigen::Matrix3d r = YawPitchRollRotation(
+        Wave(t, 0.6 * kDeg, 5.3, ph[4]), 9 * kDeg + Wave(t, 0.4 * kDeg, 3.7, ph[5]),
+        Wave(t, 0.5 * kDeg, 6.1, ph[6]));
+    return Rigid3d(r, p);
+  }
+  if (preset_ == "walking_rpy") {
+    // Rotations about yaw +-25, pitch +-15, roll +-20 degrees (10-15 deg/s), little translation.
+    const Eigen::Vector3d p =
+        base + Eigen::Vector3d(Wave(t, 0.03, 5.0, ph[0]), Wave(t, 0.03, 6.0, ph[1]),
+                               Wave(t, 0.03, 7.0, ph[2]));
+    const Eigen::Matrix3d r = YawPitchRollRotation(
+        Wave(t, 25 * kDeg, 11.0, ph[3]), 8 * kDeg + Wave(t, 15 * kDeg, 9.0, ph[4]),
+        Wave(t, 20 * kDeg, 13.0, ph[5]));
+    return Rigid3d(r, p);
+  }
+  if (preset_ == "walking_halfsphere") {
+    // On a half-sphere of 1 m diameter (behind its centre), always facing the table.
+    const Eigen::Vector3d centre(0.0, -1.4, 1.3);
+    const double az = Wave(t, 70 * kDeg, 16.0, ph[0]);
+    const double el = Wave(t, 35 * kDeg, 11.0, ph[1]);
+    const Eigen::Vector3d p =
+        centre + 0.5 * Eigen::Vector3d(std::sin(az) * std::cos(el), -std::cos(az) * std::cos(el),
+                                       std::sin(el));
+    const Eigen::Vector3d target(Wave(t, 0.3, 7.0, ph[2]), 1.0, 0.95);
+    return Rigid3d(LookAtRotation(p, target), p);
+  }
+  DETSLAM_CHECK_MSG(preset_ == "loop", "unhandled preset " << preset_);
+  // An ellipse of 3.2 x 2.0 m in the free middle of the room, once per kLoopPeriod (~0.26 m/s),
+  // looking 40 degrees outwards from the direction of travel (yaw rate ~11 deg/s).
+  const double th = 2.0 * kPi * t / kLoopPeriod;
+  const double a = 1.6, b = 1.0;
+  const Eigen::Vector3d p(a * std::sin(th), -0.6 - b * std::cos(th),
+                          1.3 + 0.04 * std::sin(3.0 * th));
+  const Eigen::Vector2d tangent = Eigen::Vector2d(a * std::cos(th), b * std::sin(th)).normalized();
+  const Eigen::Vector2d outward = Eigen::Vector2d(b * std::sin(th), -a * std::cos(th)).normalized();
+  const Eigen::Vector2d look = std::cos(40 * kDeg) * tangent + std::sin(40 * kDeg) * outward;
+  const double yaw = std::atan2(-look.x(), look.y());
+  const Eigen::Matrix3d r =
+      YawPitchRollRotation(yaw, 6 * kDeg + 2 * kDeg * std::sin(2 * th), 1.5 * kDeg * std::sin(5 * th));
+  return Rigid3d(r, p);
+}
+
+}  // namespace detslam::synth

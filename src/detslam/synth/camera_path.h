@@ -1,0 +1,37 @@
+// Smooth camera trajectories of the presets (sums of sinusoids with seeded phases, or closed
+// curves), as world_from_cam poses. Camera frame: x right, y down, z forward (optical axis).
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <string>
+
+#include "detslam/core/rigid3d.h"
+
+namespace detslam::synth {
+
+// Orientation of a camera at `position` looking at `target` with world +z up (world_from_cam).
+Eigen::Matrix3d LookAtRotation(const Eigen::Vector3d& position, const Eigen::Vector3d& target);
+
+// Orientation looking horizontally along heading `yaw` (radians, 0 = world +y, positive towards
+// -x, i.e. counter-clockwise seen from above), tilted down by `pitch_down` and rolled by `roll`
+// about the optical axis.
+Eigen::Matrix3d YawPitchRollRotation(double yaw, double pitch_down, double roll);
+
+class CameraPath {
+ public:
+  // `preset` must be valid (see options.h); `seed` picks the phases of the motion.
+  CameraPath(const std::string& preset, uint64_t seed);
+
+  // Camera pose at time `t` seconds after the first frame.
+  Rigid3d WorldFromCam(double t) const;
+
+  // Period of the loop preset's circuit in seconds (the camera is back at its start then).
+  static constexpr double kLoopPeriod = 32.0;
+
+ private:
+  std::string preset_;
+  double phase_[8];
+};
+
+}  // namespace detslam::synth

@@ -1,0 +1,28 @@
+// Ray caster of the synthetic world: for every pixel the nearest hit among the scene's boxes and
+// the people's billboards gives colour (texture x Lambert + ambient shading), depth along the
+// optical axis and the instance id. Rows are rendered in parallel; each pixel depends only on the
+// inputs, so the result does not depend on the thread split.
+#pragma once
+
+#include <opencv2/core.hpp>
+#include <vector>
+
+#include "detslam/core/camera.h"
+#include "detslam/core/rigid3d.h"
+#include "detslam/synth/people.h"
+#include "detslam/synth/scene.h"
+
+namespace detslam::synth {
+
+// A noise-free rendering.
+struct IdealFrame {
+  cv::Mat bgr;    // CV_8UC3 colour
+  cv::Mat depth;  // CV_32F depth along the optical axis (metres), 0 where nothing was hit
+  cv::Mat ids;    // CV_16U instance id: 0 static scene, k for person k
+};
+
+IdealFrame RenderIdeal(const Scene& scene, const std::vector<PersonLook>& looks,
+                       const std::vector<PersonState>& people, const PinholeCamera& camera,
+                       const Rigid3d& world_from_cam);
+
+}  // namespace detslam::synth
