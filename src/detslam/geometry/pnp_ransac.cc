@@ -33,11 +33,16 @@ class PnpProblem {
   PnpProblem(const PinholeCamera& camera, const std::vector<Eigen::Vector3d>& points,
              const std::vector<Eigen::Vector2d>& pixels, const std::vector<double>& sigma2,
              double chi2)
-      : camera_(camera), points_(points), pixels_(pixels), sigma2_(sigma2), chi2_(chi2),
+      : camera_(camera),
+        points_(points),
+        pixels_(pixels),
+        sigma2_(sigma2),
+        chi2_(chi2),
         k_(camera.fx, 0, camera.cx, 0, camera.fy, camera.cy, 0, 0, 1) {}
 
   // Solves on the given indices with OpenCV; false when OpenCV fails or rejects the sample.
-  bool Solve(const std::vector<int>& indices, int flags, const Rigid3d* guess, Rigid3d* pose) const {
+  bool Solve(const std::vector<int>& indices, int flags, const Rigid3d* guess,
+             Rigid3d* pose) const {
     std::vector<cv::Point3d> obj;
     std::vector<cv::Point2d> img;
     obj.reserve(indices.size());
@@ -106,14 +111,14 @@ std::vector<int> Indices(const std::vector<bool>& mask) {
 
 }  // namespace
 
-PnpResult SolvePnpRansac(const PinholeCamera& camera, const std::vector<Eigen::Vector3d>& points_world,
+PnpResult SolvePnpRansac(const PinholeCamera& camera,
+                         const std::vector<Eigen::Vector3d>& points_world,
                          const std::vector<Eigen::Vector2d>& pixels,
                          const std::vector<double>& sigma2, const RansacOptions& options,
                          Rng& rng) {
   std::string error;
   if (!options.Check(&error)) throw InputError("SolvePnpRansac options: " + error);
-  if (points_world.size() != pixels.size() ||
-      (!sigma2.empty() && sigma2.size() != pixels.size())) {
+  if (points_world.size() != pixels.size() || (!sigma2.empty() && sigma2.size() != pixels.size())) {
     throw InputError("SolvePnpRansac: points, pixels and sigma2 sizes differ");
   }
   for (const double s2 : sigma2) {
@@ -138,8 +143,8 @@ PnpResult SolvePnpRansac(const PinholeCamera& camera, const std::vector<Eigen::V
     if (count > best_count) {
       best_count = count;
       best_pose = pose;
-      needed = AdaptiveIterations(static_cast<double>(count) / n, kSampleSize,
-                                  options.probability, options.max_iterations);
+      needed = AdaptiveIterations(static_cast<double>(count) / n, kSampleSize, options.probability,
+                                  options.max_iterations);
     }
   }
   if (best_count < std::max(kSampleSize, options.min_inliers)) return result;

@@ -53,8 +53,8 @@ TEST(TriangulationTest, RotatedSecondCamera) {
   const Eigen::Vector3d c1 = cam1_from_world * truth, c2 = cam2_from_world * truth;
   ASSERT_GT(c2.z(), 0.0);
   Eigen::Vector3d p;
-  ASSERT_TRUE(TriangulateLinear(cam1_from_world, cam2_from_world, c1.hnormalized(),
-                                c2.hnormalized(), &p));
+  ASSERT_TRUE(
+      TriangulateLinear(cam1_from_world, cam2_from_world, c1.hnormalized(), c2.hnormalized(), &p));
   EXPECT_LT((p - truth).norm(), 1e-10);
 }
 

@@ -6,9 +6,9 @@
 namespace detslam {
 
 struct RansacOptions {
-  int max_iterations = 300;      // upper bound on minimal-sample hypotheses
-  double probability = 0.99;     // confidence for the adaptive iteration count
-  int min_inliers = 10;          // fewer inliers than this -> success = false
+  int max_iterations = 300;       // upper bound on minimal-sample hypotheses
+  double probability = 0.99;      // confidence for the adaptive iteration count
+  int min_inliers = 10;           // fewer inliers than this -> success = false
   double chi2_threshold = 5.991;  // PnP inlier test on squared pixel error / sigma2 (chi2, 2 dof)
 
   bool Check(std::string* error) const;

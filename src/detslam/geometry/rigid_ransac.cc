@@ -87,8 +87,8 @@ RigidRansacResult EstimateRigidRansac(const std::vector<Eigen::Vector3d>& a,
     if (count > best_count) {
       best_count = count;
       best = hypothesis;
-      needed = AdaptiveIterations(static_cast<double>(count) / n, kSampleSize,
-                                  options.probability, options.max_iterations);
+      needed = AdaptiveIterations(static_cast<double>(count) / n, kSampleSize, options.probability,
+                                  options.max_iterations);
     }
   }
   if (best_count < kSampleSize) return result;

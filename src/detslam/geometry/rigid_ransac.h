@@ -11,11 +11,11 @@
 namespace detslam {
 
 struct RigidRansacResult {
-  bool success = false;        // enough inliers (>= min_inliers)
-  Rigid3d b_from_a;            // maps a[i] onto b[i] for the inliers
-  std::vector<bool> inliers;   // per pair: |b - b_from_a * a| < inlier_threshold_m
+  bool success = false;       // enough inliers (>= min_inliers)
+  Rigid3d b_from_a;           // maps a[i] onto b[i] for the inliers
+  std::vector<bool> inliers;  // per pair: |b - b_from_a * a| < inlier_threshold_m
   int num_inliers = 0;
-  int iterations = 0;          // hypotheses drawn
+  int iterations = 0;  // hypotheses drawn
 };
 
 // Closed-form least-squares rigid fit (Kabsch, no scale) of b_from_a on the given pairs;

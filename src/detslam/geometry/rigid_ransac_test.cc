@@ -22,7 +22,8 @@ RigidScene MakeScene(int n, double outlier_ratio, Rng& rng) {
     const Eigen::Vector3d a(rng.Uniform(-3, 3), rng.Uniform(-3, 3), rng.Uniform(0, 6));
     Eigen::Vector3d b = s.b_from_a * a;
     const bool outlier = i % 5 < 2 && outlier_ratio > 0;  // 40% of the pairs
-    if (outlier) b += Eigen::Vector3d(rng.Uniform(0.5, 2), rng.Uniform(-2, -0.5), rng.Uniform(0.5, 2));
+    if (outlier)
+      b += Eigen::Vector3d(rng.Uniform(0.5, 2), rng.Uniform(-2, -0.5), rng.Uniform(0.5, 2));
     s.a.push_back(a);
     s.b.push_back(b);
     s.is_inlier.push_back(!outlier);

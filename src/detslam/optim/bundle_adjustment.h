@@ -16,21 +16,21 @@ namespace detslam {
 // What the optimiser works on: plain values referring to each other by index.
 struct BundleProblem {
   struct Pose {
-    int64_t id = -1;           // caller's keyframe id (not used by the solver)
+    int64_t id = -1;  // caller's keyframe id (not used by the solver)
     Rigid3d cam_from_world;
-    bool fixed = false;        // held constant (anchors the gauge; at least one is needed)
+    bool fixed = false;  // held constant (anchors the gauge; at least one is needed)
   };
   struct Point {
-    int64_t id = -1;           // caller's landmark id (not used by the solver)
+    int64_t id = -1;  // caller's landmark id (not used by the solver)
     Eigen::Vector3d p_world = Eigen::Vector3d::Zero();
     bool fixed = false;
   };
   struct Observation {
-    size_t pose_index = 0;     // into poses
-    size_t point_index = 0;    // into points
+    size_t pose_index = 0;                         // into poses
+    size_t point_index = 0;                        // into points
     Eigen::Vector2d uv = Eigen::Vector2d::Zero();  // undistorted keypoint (pixels)
-    double u_right = -1;       // virtual right u; < 0: mono observation
-    double inv_sigma2 = 1;     // information scale of the keypoint's octave
+    double u_right = -1;                           // virtual right u; < 0: mono observation
+    double inv_sigma2 = 1;                         // information scale of the keypoint's octave
   };
   std::vector<Pose> poses;
   std::vector<Point> points;
@@ -47,11 +47,11 @@ struct BundleOptions {
 };
 
 struct BundleSummary {
-  int iterations = 0;          // LM iterations taken (0 when aborted before the first step)
-  double initial_cost = 0;     // Ceres cost (0.5 * sum of robustified chi2) before
-  double final_cost = 0;       // ... and after
-  std::vector<bool> outlier;   // per observation: chi2 above threshold or point behind the camera
-  bool usable = false;         // false when no pose is fixed (gauge free) or Ceres failed
+  int iterations = 0;         // LM iterations taken (0 when aborted before the first step)
+  double initial_cost = 0;    // Ceres cost (0.5 * sum of robustified chi2) before
+  double final_cost = 0;      // ... and after
+  std::vector<bool> outlier;  // per observation: chi2 above threshold or point behind the camera
+  bool usable = false;        // false when no pose is fixed (gauge free) or Ceres failed
 };
 
 // Optimises the non-fixed poses and points in place. Without a fixed pose the problem is left

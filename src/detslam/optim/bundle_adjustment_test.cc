@@ -68,7 +68,8 @@ double MeanPoseError(const BundleProblem& a, const BundleProblem& b) {
 
 double MeanPointError(const BundleProblem& a, const BundleProblem& b) {
   double sum = 0;
-  for (size_t j = 0; j < a.points.size(); ++j) sum += (a.points[j].p_world - b.points[j].p_world).norm();
+  for (size_t j = 0; j < a.points.size(); ++j)
+    sum += (a.points[j].p_world - b.points[j].p_world).norm();
   return sum / a.points.size();
 }
 

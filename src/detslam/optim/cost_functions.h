@@ -91,8 +91,10 @@ class PoseOnlyStereoCost {
  public:
   PoseOnlyStereoCost(const StereoIntrinsics& k, const Eigen::Vector3d& observed_uvr,
                      const Eigen::Vector3d& point_world, double sqrt_info)
-      : k_(k), obs_{observed_uvr.x(), observed_uvr.y(), observed_uvr.z()},
-        p_{point_world.x(), point_world.y(), point_world.z()}, sqrt_info_(sqrt_info) {}
+      : k_(k),
+        obs_{observed_uvr.x(), observed_uvr.y(), observed_uvr.z()},
+        p_{point_world.x(), point_world.y(), point_world.z()},
+        sqrt_info_(sqrt_info) {}
   template <typename T>
   bool operator()(const T* q, const T* t, T* residual) const {
     const T p[3] = {T(p_[0]), T(p_[1]), T(p_[2])};
@@ -116,8 +118,10 @@ class PoseOnlyMonoCost {
  public:
   PoseOnlyMonoCost(const StereoIntrinsics& k, const Eigen::Vector2d& observed_uv,
                    const Eigen::Vector3d& point_world, double sqrt_info)
-      : k_(k), obs_{observed_uv.x(), observed_uv.y(), 0.0},
-        p_{point_world.x(), point_world.y(), point_world.z()}, sqrt_info_(sqrt_info) {}
+      : k_(k),
+        obs_{observed_uv.x(), observed_uv.y(), 0.0},
+        p_{point_world.x(), point_world.y(), point_world.z()},
+        sqrt_info_(sqrt_info) {}
   template <typename T>
   bool operator()(const T* q, const T* t, T* residual) const {
     const T p[3] = {T(p_[0]), T(p_[1]), T(p_[2])};

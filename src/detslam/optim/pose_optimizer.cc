@@ -152,7 +152,7 @@ Eigen::Matrix<double, 3, 6> StereoPoseJacobian(const PinholeCamera& camera,
                                                const Eigen::Vector3d& p_cam) {
   const double inv_z = 1.0 / p_cam.z();
   const double inv_z2 = inv_z * inv_z;
-  Eigen::Matrix3d d_proj;  // d(u, v, u_right) / d(p_cam)
+  Eigen::Matrix3d d_proj;                                             // d(u, v, u_right) / d(p_cam)
   d_proj << camera.fx * inv_z, 0.0, -camera.fx * p_cam.x() * inv_z2,  //
       0.0, camera.fy * inv_z, -camera.fy * p_cam.y() * inv_z2,        //
       camera.fx * inv_z, 0.0, (camera.bf - camera.fx * p_cam.x()) * inv_z2;

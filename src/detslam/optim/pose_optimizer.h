@@ -17,8 +17,8 @@ namespace detslam {
 struct PoseObservation {
   Eigen::Vector3d point_world = Eigen::Vector3d::Zero();  // fixed landmark position
   Eigen::Vector2d uv = Eigen::Vector2d::Zero();           // undistorted keypoint (pixels)
-  double u_right = -1;      // virtual right-camera u (u - bf / depth); < 0: mono observation
-  double inv_sigma2 = 1;    // information scale of the keypoint's octave (1 / sigma^2)
+  double u_right = -1;    // virtual right-camera u (u - bf / depth); < 0: mono observation
+  double inv_sigma2 = 1;  // information scale of the keypoint's octave (1 / sigma^2)
 };
 
 struct PoseOptimizerOptions {
@@ -31,8 +31,8 @@ struct PoseOptimizerOptions {
 };
 
 struct PoseOptimizerResult {
-  Rigid3d cam_from_world;      // optimised pose
-  std::vector<bool> inliers;   // per observation, after the last classification
+  Rigid3d cam_from_world;     // optimised pose
+  std::vector<bool> inliers;  // per observation, after the last classification
   int num_inliers = 0;
 };
 

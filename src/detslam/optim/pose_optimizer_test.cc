@@ -34,7 +34,8 @@ std::vector<PoseObservation> MakeObservations(const PinholeCamera& camera, int n
     const double scale = std::pow(1.2, octave);
     PoseObservation o;
     o.point_world = world_from_cam * p_cam;
-    o.uv = uvr.head<2>() + Eigen::Vector2d(rng.Normal(0, noise_px), rng.Normal(0, noise_px)) * scale;
+    o.uv =
+        uvr.head<2>() + Eigen::Vector2d(rng.Normal(0, noise_px), rng.Normal(0, noise_px)) * scale;
     if (i % 2 == 0) o.u_right = o.uv.x() - (uvr.x() - uvr.z());
     o.inv_sigma2 = 1.0 / (scale * scale);
     obs.push_back(o);
