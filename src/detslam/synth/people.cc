@@ -198,8 +198,8 @@ PeopleScript::PeopleScript(const std::string& preset, uint64_t seed) {
   }
   // Walking presets: two people crossing the view back and forth in front of the table
   // (1.3-2.2 m from the camera), at up to ~1 m/s, leaving and re-entering the view.
-  walkers_.push_back({{0.0, 0.0}, {1, 0.08}, 1.35, 11.0, phase(), 0.12, 1.74, false});
-  walkers_.push_back({{0.1, 0.4}, {-1, 0.15}, 1.4, 14.0, phase(), 0.10, 1.68, false});
+  walkers_.push_back({{0.0, -0.25}, {1, 0.08}, 1.2, 11.0, phase(), 0.12, 1.74, false});
+  walkers_.push_back({{0.1, 0.25}, {-1, 0.15}, 1.3, 14.0, phase(), 0.10, 1.68, false});
   for (auto& w : walkers_) w.axis.normalize();
 }
 
