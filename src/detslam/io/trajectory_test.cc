@@ -18,7 +18,9 @@ void WriteText(const std::string& path, const std::string& text) { std::ofstream
 
 TEST(Trajectory, WriteReadRoundTrip) {
   Trajectory t;
-  t.push_back({Timestamp::FromSeconds(1311868164.363181),
+  Timestamp stamp;
+  ASSERT_TRUE(ParseTimestamp("1311868164.363181", &stamp));
+  t.push_back({stamp,
                Rigid3d(Eigen::Quaterniond(0.5, 0.5, -0.5, 0.5), Eigen::Vector3d(1.5, -2, 0.25))});
   const std::string path = TempPath("roundtrip.txt");
   WriteTumTrajectory(path, t, "test header");

@@ -8,6 +8,23 @@
 
 namespace detslam {
 
+ProjectionCandidate CandidateFromLandmark(const Landmark& lm) {
+  ProjectionCandidate c;
+  c.landmark = lm.id;
+  c.position = lm.position;
+  c.descriptor = lm.descriptor.ptr<uint8_t>();
+  c.min_distance = lm.min_distance;
+  c.max_distance = lm.max_distance;
+  c.normal = lm.normal;
+  return c;
+}
+
+std::vector<bool> TakenMask(const Frame& frame) {
+  std::vector<bool> taken(frame.size(), false);
+  for (size_t i = 0; i < frame.size(); ++i) taken[i] = frame.landmarks[i] != kNoLandmark;
+  return taken;
+}
+
 std::vector<int> SearchByProjection(const PinholeCamera& camera, const ScaleInfo& scale,
                                     const FrameFeatures& features, const Rigid3d& cam_from_world,
                                     const std::vector<ProjectionCandidate>& candidates,

@@ -30,6 +30,12 @@ struct ProjectionSearchOptions {
   bool level_window_from_prediction = true;  // search levels [pred-1, pred]
 };
 
+// Candidate for a map landmark (position, representative descriptor, scale bounds, normal).
+ProjectionCandidate CandidateFromLandmark(const Landmark& landmark);
+
+// True for keypoints of `frame` already associated with a landmark.
+std::vector<bool> TakenMask(const Frame& frame);
+
 // For each candidate, the index of the matched keypoint in `features` (or -1). Keypoints listed in
 // `taken` (same size as features; true = already associated) are skipped. Deterministic.
 std::vector<int> SearchByProjection(const PinholeCamera& camera, const ScaleInfo& scale,

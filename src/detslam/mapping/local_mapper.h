@@ -1,0 +1,63 @@
+// Local mapping for RGB-D keyframes (ORB-SLAM3 rules): landmark culling, fusion of duplicate
+// landmarks with neighbour keyframes, local bundle adjustment (Ceres) over the keyframe's
+// covisibility neighbourhood, and redundant-keyframe culling.
+#pragma once
+
+#include <deque>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "detslam/map/map.h"
+
+namespace detslam {
+
+struct LocalMapperOptions {
+  bool local_ba = true;              // run local bundle adjustment after each keyframe
+  int ba_iterations = 10;            // Levenberg-Marquardt iterations
+  int max_local_keyframes = 20;      // optimised keyframes: current + best covisibles
+  int max_fixed_keyframes = 40;      // keyframes observing local points, kept fixed
+  bool fuse = true;                  // SearchInNeighbors
+  int fuse_neighbours = 10;          // first-order neighbours to fuse with
+  bool cull_keyframes = true;        // KeyFrameCulling
+  double redundancy = 0.9;           // cull if this fraction of points is seen by >= 3 others
+  double min_found_ratio = 0.25;     // landmark culling: found / visible
+  bool Check(std::string* error) const;
+};
+
+// A keyframe that culling removed, with its pose relative to its parent at that time, so frames
+// that referred to it can still be placed.
+struct ErasedKeyFrame {
+  KeyFrameId id = kNoKeyFrame;
+  KeyFrameId parent = kNoKeyFrame;
+  Rigid3d cam_from_parent;
+};
+
+struct LocalMappingSummary {
+  int fused = 0;
+  int culled_landmarks = 0;
+  int ba_outliers = 0;
+  double ba_ms = 0.0;
+  std::vector<ErasedKeyFrame> erased_keyframes;
+};
+
+class LocalMapper {
+ public:
+  LocalMapper(const PinholeCamera& camera, LocalMapperOptions options, Map* map);
+
+  // Processes a keyframe just inserted by the tracker. Deterministic.
+  LocalMappingSummary ProcessKeyFrame(KeyFrameId kf);
+
+ private:
+  void CullLandmarks(KeyFrameId current, LocalMappingSummary* summary);
+  void FuseWithNeighbours(KeyFrameId current, LocalMappingSummary* summary);
+  void LocalBundleAdjustment(KeyFrameId current, LocalMappingSummary* summary);
+  void CullKeyFrames(KeyFrameId current, LocalMappingSummary* summary);
+
+  PinholeCamera camera_;
+  LocalMapperOptions options_;
+  Map* map_;
+  std::deque<LandmarkId> recent_landmarks_;
+};
+
+}  // namespace detslam

@@ -1,0 +1,50 @@
+// Runs the SLAM system over a whole RGB-D dataset and writes the outputs:
+// trajectory.txt (TUM format, every tracked frame), keyframes.txt, map.ply (landmarks) and
+// run.json (settings, timings, counts). All outputs are written atomically at the end.
+#pragma once
+
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "detslam/io/dataset.h"
+#include "detslam/io/settings.h"
+#include "detslam/pipeline/slam_system.h"
+
+namespace detslam {
+
+struct RunOptions {
+  std::string out_dir = "out";  // where outputs go (created)
+  int64_t max_frames = -1;      // stop after this many frames (< 0: all)
+  SlamOptions slam;
+};
+
+// SlamOptions from settings (ORBextractor.* and any detslam keys), with `seed` for RANSAC.
+SlamOptions SlamOptionsFromSettings(const Settings& settings, uint64_t seed);
+
+struct StageStats {
+  double median_ms = 0, mean_ms = 0, p90_ms = 0, max_ms = 0;
+};
+
+struct RunSummary {
+  size_t frames = 0;
+  size_t tracked = 0;
+  size_t keyframes = 0;
+  size_t landmarks = 0;
+  size_t relocalizations = 0;
+  double wall_s = 0;
+  StageStats extraction, tracking, mapping, total;
+  std::vector<FrameReport> reports;
+  double TrackedFraction() const { return frames ? static_cast<double>(tracked) / frames : 0.0; }
+};
+
+using ProgressFn = std::function<void(size_t done, size_t total, const FrameReport& last)>;
+
+// Sequential mode: one frame at a time through extraction, tracking and local mapping.
+// Deterministic for a given dataset, settings and seed.
+RunSummary RunSequential(const RgbdDataset& dataset, const Settings& settings,
+                         const RunOptions& options, const ProgressFn& progress = nullptr);
+
+StageStats ComputeStageStats(std::vector<double> values);
+
+}  // namespace detslam

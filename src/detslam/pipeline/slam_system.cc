@@ -1,0 +1,112 @@
+#include "detslam/pipeline/slam_system.h"
+
+#include <chrono>
+#include <cmath>
+#include <sstream>
+
+#include "detslam/core/check.h"
+
+namespace detslam {
+namespace {
+
+double MsSince(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+}  // namespace
+
+bool SlamOptions::Check(std::string* error) const {
+  std::string e1, e2, e3;
+  const bool ok = orb.Check(&e1) & tracker.Check(&e2) & mapper.Check(&e3);
+  if (error) *error = e1 + e2 + e3;
+  return ok;
+}
+
+ScaleInfo MakeScaleInfo(const OrbExtractor& extractor) {
+  ScaleInfo s;
+  s.scale_factors = extractor.scale_factors();
+  s.level_sigma2 = extractor.level_sigma2();
+  s.inv_level_sigma2 = extractor.inv_level_sigma2();
+  s.log_scale_factor = std::log(extractor.options().scale_factor);
+  return s;
+}
+
+SlamSystem::SlamSystem(const PinholeCamera& camera, const SlamOptions& options)
+    : camera_(camera),
+      options_(options),
+      extractor_(options.orb),
+      map_(MakeScaleInfo(extractor_)),
+      tracker_(camera, options.tracker, &map_),
+      mapper_(camera, options.mapper, &map_) {
+  std::string error;
+  DETSLAM_CHECK_MSG(camera_.Check(&error), error);
+}
+
+FrameReport SlamSystem::ProcessFrame(int64_t index, Timestamp stamp, const cv::Mat& gray,
+                                     const cv::Mat& depth_m, const cv::Mat& ignore_mask) {
+  FrameReport report;
+  report.index = index;
+  report.stamp = stamp;
+  auto t0 = std::chrono::steady_clock::now();
+  std::vector<cv::KeyPoint> keypoints;
+  cv::Mat descriptors;
+  extractor_.Extract(gray, ignore_mask, &keypoints, &descriptors);
+  Frame frame;
+  frame.index = index;
+  frame.stamp = stamp;
+  frame.features = BuildFrameFeatures(camera_, std::move(keypoints), descriptors, depth_m);
+  report.num_keypoints = static_cast<int>(frame.size());
+  report.timings.extraction_ms = MsSince(t0);
+
+  t0 = std::chrono::steady_clock::now();
+  const size_t kfs_before = map_.NumKeyFrames();
+  report.tracking = tracker_.Track(&frame);
+  KeyFrameId new_kf = kNoKeyFrame;
+  if (report.tracking.pose_valid && report.tracking.need_keyframe) new_kf = tracker_.CreateKeyFrame(&frame);
+  if (map_.NumKeyFrames() > kfs_before && new_kf == kNoKeyFrame) new_kf = tracker_.reference_keyframe();
+  report.timings.tracking_ms = MsSince(t0);
+
+  if (report.tracking.pose_valid) {
+    const KeyFrameId ref = frame.reference_keyframe != kNoKeyFrame ? frame.reference_keyframe : tracker_.reference_keyframe();
+    tracked_.push_back({stamp, ref, *frame.cam_from_world * map_.keyframe(ref).cam_from_world.Inverse()});
+  }
+  if (new_kf != kNoKeyFrame) {
+    report.keyframe = true;
+    t0 = std::chrono::steady_clock::now();
+    const LocalMappingSummary s = mapper_.ProcessKeyFrame(new_kf);
+    for (const ErasedKeyFrame& e : s.erased_keyframes) {
+      erased_[e.id] = e;
+      tracker_.OnKeyFrameErased(e.id);
+    }
+    report.timings.mapping_ms = MsSince(t0);
+  }
+  return report;
+}
+
+Rigid3d SlamSystem::ReferenceWorldFromCam(KeyFrameId id, const Rigid3d& cam_from_ref) const {
+  // Walk up through erased keyframes to one that still exists.
+  Rigid3d cam_from_kf = cam_from_ref;
+  KeyFrameId kf = id;
+  for (int guard = 0; !map_.HasKeyFrame(kf) && guard < 100000; ++guard) {
+    auto it = erased_.find(kf);
+    DETSLAM_CHECK_MSG(it != erased_.end(), "keyframe " << kf << " vanished without a record");
+    cam_from_kf = cam_from_kf * it->second.cam_from_parent;
+    kf = it->second.parent;
+  }
+  return (cam_from_kf * map_.keyframe(kf).cam_from_world).Inverse();
+}
+
+Trajectory SlamSystem::FrameTrajectory() const {
+  Trajectory out;
+  out.reserve(tracked_.size());
+  for (const TrackedFrame& t : tracked_) out.push_back({t.stamp, ReferenceWorldFromCam(t.reference, t.cam_from_ref)});
+  return out;
+}
+
+Trajectory SlamSystem::KeyFrameTrajectory() const {
+  Trajectory out;
+  for (const auto& [id, kf] : map_.keyframes()) out.push_back({kf.stamp, kf.cam_from_world.Inverse()});
+  return out;
+}
+
+}  // namespace detslam

@@ -1,0 +1,76 @@
+// The RGB-D SLAM stages wired together for one sequence: feature extraction, tracking, local
+// mapping, and the trajectory bookkeeping that places every tracked frame relative to its
+// reference keyframe (so later map corrections move the frames with their keyframes).
+#pragma once
+
+#include <map>
+#include <memory>
+#include <opencv2/core.hpp>
+#include <string>
+#include <vector>
+
+#include "detslam/features/orb_extractor.h"
+#include "detslam/io/trajectory.h"
+#include "detslam/map/map.h"
+#include "detslam/mapping/local_mapper.h"
+#include "detslam/tracking/tracker.h"
+
+namespace detslam {
+
+struct SlamOptions {
+  OrbOptions orb;
+  TrackerOptions tracker;
+  LocalMapperOptions mapper;
+  bool Check(std::string* error) const;
+};
+
+// Wall-clock time of each stage for one frame, milliseconds.
+struct FrameTimings {
+  double extraction_ms = 0, tracking_ms = 0, mapping_ms = 0;
+};
+
+struct FrameReport {
+  int64_t index = 0;
+  Timestamp stamp;
+  TrackingResult tracking;
+  bool keyframe = false;
+  int num_keypoints = 0;
+  FrameTimings timings;
+};
+
+class SlamSystem {
+ public:
+  SlamSystem(const PinholeCamera& camera, const SlamOptions& options);
+
+  // Processes one RGB-D frame. gray: CV_8UC1; depth_m: CV_32FC1 metres (0 = missing);
+  // ignore_mask: empty or CV_8UC1, non-zero = no keypoints there.
+  FrameReport ProcessFrame(int64_t index, Timestamp stamp, const cv::Mat& gray,
+                           const cv::Mat& depth_m, const cv::Mat& ignore_mask = cv::Mat());
+
+  // Every tracked frame's pose, recomputed from its reference keyframe's current pose.
+  Trajectory FrameTrajectory() const;
+  // Keyframe poses (world_from_cam) in id order.
+  Trajectory KeyFrameTrajectory() const;
+  const Map& map() const { return map_; }
+
+ private:
+  Rigid3d ReferenceWorldFromCam(KeyFrameId id, const Rigid3d& cam_from_ref) const;
+
+  PinholeCamera camera_;
+  SlamOptions options_;
+  OrbExtractor extractor_;
+  Map map_;
+  Tracker tracker_;
+  LocalMapper mapper_;
+  struct TrackedFrame {
+    Timestamp stamp;
+    KeyFrameId reference;
+    Rigid3d cam_from_ref;
+  };
+  std::vector<TrackedFrame> tracked_;
+  std::map<KeyFrameId, ErasedKeyFrame> erased_;
+};
+
+ScaleInfo MakeScaleInfo(const OrbExtractor& extractor);
+
+}  // namespace detslam
