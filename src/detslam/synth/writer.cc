@@ -125,7 +125,7 @@ SynthStats WriteSequence(const SynthOptions& options, const std::string& out_dir
   write_text("masks/instances.txt", inst_txt.str());
   WriteTumTrajectory((fs::path(out_dir) / "groundtruth.txt").string(), gt,
                      "ground truth trajectory (world_from_camera)\nfile: '" + header +
-                         "'\ntimestamp tx ty tz qx qy qz qw");
+                         "'");
   WriteSynthSettings((fs::path(out_dir) / "settings.yaml").string(), seq.camera());
   stats.total_seconds += Since(start);
   stats.render_fps = stats.frames / std::max(1e-9, stats.render_seconds);
