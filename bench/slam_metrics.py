@@ -1,0 +1,93 @@
+#!/usr/bin/env python3
+"""Small helpers for bench/bench_slam.sh: read detslam run.json / eval JSON files and compute the
+end drift of a trajectory (the last pose's position error after aligning the first poses only).
+
+Usage:
+  slam_metrics.py field FILE.json key.path        -> prints the value
+  slam_metrics.py drift groundtruth.txt trajectory.txt -> prints 'drift_m path_m'
+"""
+import json
+import math
+import sys
+
+
+def get(path, dotted):
+    with open(path) as f:
+        v = json.load(f)
+    for k in dotted.split("."):
+        v = v[k]
+    return v
+
+
+def read_tum(path):
+    out = []
+    with open(path) as f:
+        for line in f:
+            s = line.strip()
+            if not s or s.startswith("#"):
+                continue
+            v = [float(x) for x in s.replace(",", " ").split()]
+            out.append(v[:8])
+    return out
+
+
+def qmul(a, b):
+    ax, ay, az, aw = a
+    bx, by, bz, bw = b
+    return (aw * bx + ax * bw + ay * bz - az * by,
+            aw * by - ax * bz + ay * bw + az * bx,
+            aw * bz + ax * by - ay * bx + az * bw,
+            aw * bw - ax * bx - ay * by - az * bz)
+
+
+def qrot(q, v):
+    x, y, z, w = q
+    p = qmul(qmul(q, (v[0], v[1], v[2], 0.0)), (-x, -y, -z, w))
+    return p[:3]
+
+
+def qinv(q):
+    return (-q[0], -q[1], -q[2], q[3])
+
+
+def drift(gt_path, est_path):
+    gt = read_tum(gt_path)
+    est = read_tum(est_path)
+    if not gt or not est:
+        raise SystemExit("empty trajectory")
+
+    def closest(t):
+        return min(gt, key=lambda g: abs(g[0] - t))
+    g0, e0 = closest(est[0][0]), est[0]
+    g1, e1 = closest(est[-1][0]), est[-1]
+    # world_gt_from_world_est = T_gt0 * T_est0^-1
+    q = qmul(tuple(g0[4:8]), qinv(tuple(e0[4:8])))
+    t0 = [g0[1 + i] - qrot(q, e0[1:4])[i] for i in range(3)]
+    p = [qrot(q, e1[1:4])[i] + t0[i] for i in range(3)]
+    d = math.dist(p, g1[1:4])
+    length = 0.0
+    prev = None
+    for g in gt:
+        if g[0] < est[0][0] - 0.02 or g[0] > est[-1][0] + 0.02:
+            continue
+        if prev is not None:
+            length += math.dist(g[1:4], prev)
+        prev = g[1:4]
+    return d, length
+
+
+def main():
+    if len(sys.argv) == 4 and sys.argv[1] == "field":
+        v = get(sys.argv[2], sys.argv[3])
+        print(f"{v:.6g}" if isinstance(v, float) else v)
+    elif len(sys.argv) == 4 and sys.argv[1] == "drift":
+        d, length = drift(sys.argv[2], sys.argv[3])
+        print(f"{d:.6f} {length:.6f}")
+    else:
+        print(__doc__, file=sys.stderr)
+        return 2
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
