@@ -22,6 +22,7 @@ presets="static walking_xyz walking_static walking_rpy walking_halfsphere sittin
   echo "Render fps: ray casting + people + sensor noise; total fps adds PNG encoding and atomic"
   echo "writes (and the one-off scene texture build). FAST corners: cv::FAST threshold 20 with"
   echo "non-max suppression on every 5th frame. Coverage: mean fraction of pixels on people."
+  echo "Load average at start: $(cut -d' ' -f1-3 /proc/loadavg) (fps drop when other jobs share the cores)."
   echo
   echo "| preset | frames | render fps | total fps | mean FAST-20 corners | mean people coverage % |"
   echo "|---|---:|---:|---:|---:|---:|"
