@@ -1,0 +1,21 @@
+// Builds a segmenter from the command line's --segmenter value.
+#pragma once
+
+#include <memory>
+#include <string>
+
+#include "detslam/io/settings.h"
+#include "detslam/segmentation/segmenter.h"
+
+namespace detslam {
+
+// spec:
+//   "dnn"        DnnSegmenter with DnnOptionsFromSettings(settings, models_dir)
+//   "masks:DIR"  MaskDirSegmenter reading DIR (mask_dir.h format)
+//   "gt"         MaskDirSegmenter on <dataset_dir>/masks (synthetic sequences' ground truth)
+//   "none"       nullptr (no segmentation)
+// Throws InputError for an unknown spec, a missing folder or missing models.
+std::unique_ptr<Segmenter> MakeSegmenter(const std::string& spec, const std::string& dataset_dir,
+                                         const Settings& settings, const std::string& models_dir);
+
+}  // namespace detslam

@@ -1,0 +1,118 @@
+#include "detslam/segmentation/segmenter_factory.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "detslam/core/check.h"
+#include "detslam/segmentation/coco_classes.h"
+#include "detslam/segmentation/dnn_segmenter.h"
+#include "detslam/segmentation/mask_dir.h"
+
+namespace detslam {
+namespace {
+namespace fs = std::filesystem;
+
+std::string ErrorOf(const std::function<void()>& fn) {
+  try {
+    fn();
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(SegmenterFactory, NoneGtMasksAndUnknown) {
+  const fs::path dir = fs::temp_directory_path() / "detslam_factory_test";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  Settings settings;
+  EXPECT_EQ(MakeSegmenter("none", dir.string(), settings, "/nonexistent"), nullptr);
+  const std::string gt_error = ErrorOf([&] { MakeSegmenter("gt", dir.string(), settings, ""); });
+  EXPECT_NE(gt_error.find("synthetic"), std::string::npos) << gt_error;
+  EXPECT_NE(gt_error.find((dir / "masks").string()), std::string::npos) << gt_error;
+  WriteMasks((dir / "masks").string(), {}, {}, cv::Size(4, 4));
+  auto gt = MakeSegmenter("gt", dir.string(), settings, "");
+  ASSERT_NE(gt, nullptr);
+  EXPECT_EQ(gt->name(), "gt");
+  auto masks = MakeSegmenter("masks:" + (dir / "masks").string(), "", settings, "");
+  ASSERT_NE(masks, nullptr);
+  EXPECT_EQ(masks->name(), "masks");
+  EXPECT_THROW(MakeSegmenter("masks:", "", settings, ""), InputError);
+  EXPECT_THROW(MakeSegmenter("maskrcnn2", "", settings, ""), InputError);
+  fs::remove_all(dir);
+}
+
+TEST(SegmenterFactory, MissingModelsNameEveryPathLookedAt) {
+  Settings settings;
+  const std::string e =
+      ErrorOf([&] { MakeSegmenter("dnn", "", settings, "/nonexistent/models"); });
+  EXPECT_NE(e.find("/nonexistent/models/yolox_nano/yolox_nano.onnx"), std::string::npos) << e;
+  EXPECT_NE(e.find("/nonexistent/models/yolox_nano/coco.names"), std::string::npos) << e;
+  EXPECT_NE(e.find("/nonexistent/models/selfie_segmentation/selfie_segmentation.onnx"),
+            std::string::npos)
+      << e;
+  EXPECT_NE(e.find("MISSING"), std::string::npos) << e;
+}
+
+TEST(DnnOptions, FromSettingsResolvesCompanionsAndClasses) {
+  Settings s;
+  s.extra["Segmentation.Detector"] = "yolo_fastest_1.1/yolo-fastest-1.1_body.cfg";
+  s.extra["Segmentation.PersonMask"] = "none";
+  s.extra["Segmentation.ScoreThreshold"] = "0.5";
+  s.extra["Segmentation.DynamicClasses"] = "person, chair,traffic light";
+  const DnnSegmenterOptions o = DnnOptionsFromSettings(s, "/m");
+  EXPECT_EQ(o.detector_path, "/m/yolo_fastest_1.1/yolo-fastest-1.1_body.cfg");
+  EXPECT_EQ(o.weights_path, "/m/yolo_fastest_1.1/yolo-fastest-1.1_body.weights");
+  EXPECT_EQ(o.names_path, "/m/yolo_fastest_1.1/body.names");
+  EXPECT_TRUE(o.person_mask_model.empty());
+  EXPECT_FLOAT_EQ(o.score_threshold, 0.5f);
+  EXPECT_EQ(o.classes, (std::vector<std::string>{"person", "chair", "traffic light"}));
+  const auto looked = LookedForModels(o);
+  EXPECT_EQ(looked.size(), 3u);
+
+  const DnnSegmenterOptions d = DnnOptionsFromSettings(Settings(), "/m");
+  EXPECT_EQ(d.detector_path, "/m/yolox_nano/yolox_nano.onnx");
+  EXPECT_EQ(d.names_path, "/m/yolox_nano/coco.names");
+  EXPECT_EQ(d.person_mask_model, "/m/selfie_segmentation/selfie_segmentation.onnx");
+  EXPECT_TRUE(d.weights_path.empty());
+  EXPECT_TRUE(d.classes.empty());
+  std::string error;
+  EXPECT_TRUE(d.Check(&error)) << error;
+}
+
+TEST(DnnOptions, CheckRejectsBadValues) {
+  DnnSegmenterOptions o;
+  o.detector_path = "x.onnx";
+  std::string error;
+  EXPECT_TRUE(o.Check(&error)) << error;
+  o.detector_path = "x.pb";
+  EXPECT_FALSE(o.Check(&error));
+  o.detector_path = "x.onnx";
+  o.score_threshold = 1.5f;
+  EXPECT_FALSE(o.Check(&error));
+  o.score_threshold = 0.3f;
+  o.yolox_input_size = 400;
+  EXPECT_FALSE(o.Check(&error));
+  EXPECT_NE(error.find("32"), std::string::npos);
+}
+
+TEST(DnnOptions, DefaultModelsDirHonoursEnvironment) {
+  setenv("DETSLAM_MODELS", "/tmp/my_models", 1);
+  EXPECT_EQ(DefaultModelsDir(), "/tmp/my_models");
+  unsetenv("DETSLAM_MODELS");
+  EXPECT_FALSE(DefaultModelsDir().empty());
+}
+
+TEST(CocoClasses, NamesAndIds) {
+  ASSERT_EQ(CocoClassNames().size(), 80u);
+  EXPECT_EQ(CocoClassId("person"), 0);
+  EXPECT_EQ(CocoClassId("body"), 0);
+  EXPECT_EQ(CocoClassId("chair"), 56);
+  EXPECT_EQ(CocoClassId("toothbrush"), 79);
+  EXPECT_EQ(CocoClassId("unicorn"), -1);
+}
+
+}  // namespace
+}  // namespace detslam
