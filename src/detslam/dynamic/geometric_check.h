@@ -1,0 +1,45 @@
+// A geometric check for movers the detector misses: after pose prediction, keypoints matched to
+// map points whose residual (reprojection error in pixels, or depth error in metres) lies far above
+// that of the other static keypoints are labelled kGeometric.
+//
+// Robust statistics over the static keypoints with a residual: threshold =
+//   max(min_threshold, median + k * 1.4826 * MAD),  MAD = median(|r - median|),
+// (1.4826 * MAD estimates the standard deviation of Gaussian residuals). Static keypoints with a
+// residual above the threshold become kGeometric. With fewer than `min_samples` residuals the
+// statistics are not trusted and nothing is flagged.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "detslam/map/frame.h"
+
+namespace detslam {
+
+struct GeometricCheckOptions {
+  double k = 3.0;              // threshold in robust standard deviations above the median
+  double min_threshold = 2.0;  // floor on the threshold, in the residuals' unit (e.g. pixels)
+  int min_samples = 10;        // fewer static residuals than this: flag nothing
+
+  bool Check(std::string* error) const;
+};
+
+struct GeometricCheckResult {
+  int samples = 0;         // static keypoints with a valid residual
+  double median = 0.0;     // median residual of those
+  double mad = 0.0;        // median absolute deviation (unscaled)
+  double threshold = 0.0;  // residuals above this are flagged (infinity when nothing is flagged)
+  int flagged = 0;         // keypoints labelled kGeometric by this call
+};
+
+// Median of `values` (mean of the two middle values for an even count); 0 when empty.
+double Median(std::vector<double> values);
+
+// `residuals[i]`: keypoint i's residual against the predicted pose; negative or non-finite = none
+// (unmatched). Only kStatic keypoints contribute and only they are relabelled.
+// residuals.size() must equal labels->size().
+GeometricCheckResult FlagGeometricOutliers(const std::vector<double>& residuals,
+                                           const GeometricCheckOptions& options,
+                                           std::vector<KeypointLabel>* labels);
+
+}  // namespace detslam
