@@ -18,5 +18,6 @@ struct CommandFailed : std::runtime_error {
 void AddEvalCommand(CLI::App& app);
 void AddSynthCommand(CLI::App& app);
 void AddRunCommand(CLI::App& app);
+void AddSegmentCommand(CLI::App& app);
 
 }  // namespace detslam::app

@@ -18,6 +18,7 @@ int main(int argc, char** argv) {
   detslam::app::AddRunCommand(app);
   detslam::app::AddEvalCommand(app);
   detslam::app::AddSynthCommand(app);
+  detslam::app::AddSegmentCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
