@@ -1,0 +1,95 @@
+// The OpenCV-dnn (CPU) segmenter: a COCO detector (YOLOX ONNX, or Yolo-Fastest Darknet cfg +
+// weights) finds boxes; person boxes get a MediaPipe Selfie Segmentation mask computed on the box
+// expanded by `box_expand`; other classes get the box pixels at the object's dominant depth
+// (box_mask.h). Models: ../shared/models/README.md (or $DETSLAM_MODELS).
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "detslam/io/settings.h"
+#include "detslam/segmentation/box_mask.h"
+#include "detslam/segmentation/segmenter.h"
+
+namespace detslam {
+
+class PersonMaskModel;
+
+struct DnnSegmenterOptions {
+  std::string detector_path;      // .onnx (YOLOX) or .cfg (Darknet, with weights_path)
+  std::string weights_path;       // Darknet weights; empty = detector path with .weights
+  std::string names_path;         // class names, one per line; empty = coco.names beside the
+                                  // detector (body.names for a *_body.cfg)
+  std::string person_mask_model;  // selfie_segmentation.onnx; empty = box (depth) masks only
+  float score_threshold = 0.35f;  // minimum detection score (obj * class for YOLOX)
+  float nms_threshold = 0.45f;    // IoU above which same-class boxes are suppressed
+  double box_expand = 0.10;       // person box grown by this fraction per side for the mask crop
+  std::vector<std::string> classes;  // class names to return; empty = all
+  int yolox_input_size = 416;     // square input of the YOLOX export (multiple of 32)
+  int darknet_input_size = 320;   // square input of the Darknet model
+  float person_mask_threshold = 0.5f;  // selfie probability above which a pixel is person
+  DominantDepthOptions depth_mask;     // masks of classes without a mask model
+
+  bool Check(std::string* error) const;
+};
+
+// Fills empty weights_path / names_path from the detector path (see the field comments).
+void ResolveModelCompanions(DnnSegmenterOptions* options);
+
+// Every model file the options need (detector, weights for Darknet, names, person mask model),
+// after ResolveModelCompanions.
+std::vector<std::string> LookedForModels(const DnnSegmenterOptions& options);
+
+// Models folder: $DETSLAM_MODELS if set, else the build's default (<shared>/models).
+std::string DefaultModelsDir();
+
+// Options from settings keys (all optional; relative paths resolve against models_dir):
+//   Segmentation.Detector        default <models_dir>/yolox_nano/yolox_nano.onnx
+//   Segmentation.Weights         default: beside the detector (Darknet only)
+//   Segmentation.Names           default: coco.names beside the detector
+//   Segmentation.PersonMask      default <models_dir>/selfie_segmentation/selfie_segmentation.onnx
+//                                ("none" = box masks only)
+//   Segmentation.ScoreThreshold  Segmentation.NmsThreshold  Segmentation.BoxExpand
+//   Segmentation.InputSize       YOLOX input side (default 416)
+//   Segmentation.DynamicClasses  comma-separated class names to return (default: all)
+DnnSegmenterOptions DnnOptionsFromSettings(const Settings& settings, const std::string& models_dir);
+
+// Time spent by the last Segment() call.
+struct DnnTimings {
+  double detect_ms = 0;  // preprocessing + network + decoding + NMS
+  double mask_ms = 0;    // person masks and depth masks of all instances
+};
+
+class DnnSegmenter : public Segmenter {
+ public:
+  // Loads the networks. Throws InputError if the options are invalid or a model file is missing
+  // (the message names the missing file and every path looked at) or unreadable.
+  explicit DnnSegmenter(const DnnSegmenterOptions& options);
+  ~DnnSegmenter() override;
+
+  std::vector<Instance> Segment(const SegmenterInput& input) override;
+  std::string name() const override { return name_; }
+  const DnnTimings& last_timings() const { return timings_; }
+  const std::vector<std::string>& class_names() const { return names_; }
+
+ private:
+  struct Detection {
+    int class_id;
+    float score;
+    cv::Rect box;
+  };
+  std::vector<Detection> DetectYolox(const cv::Mat& bgr);
+  std::vector<Detection> DetectDarknet(const cv::Mat& bgr);
+
+  DnnSegmenterOptions options_;
+  std::string name_;
+  bool darknet_ = false;
+  std::vector<std::string> names_;
+  struct Nets;
+  std::unique_ptr<Nets> nets_;
+  std::unique_ptr<PersonMaskModel> person_mask_;
+  DnnTimings timings_;
+};
+
+}  // namespace detslam
