@@ -5,6 +5,7 @@
 #include "detslam/core/check.h"
 #include "detslam/segmentation/dnn_segmenter.h"
 #include "detslam/segmentation/mask_dir.h"
+#include "detslam/segmentation/mask_rcnn_segmenter.h"
 
 namespace detslam {
 
@@ -13,6 +14,9 @@ std::unique_ptr<Segmenter> MakeSegmenter(const std::string& spec, const std::str
   if (spec == "none") return nullptr;
   if (spec == "dnn") {
     return std::make_unique<DnnSegmenter>(DnnOptionsFromSettings(settings, models_dir));
+  }
+  if (spec == "maskrcnn") {
+    return std::make_unique<MaskRcnnSegmenter>(MaskRcnnOptionsFromSettings(settings, models_dir));
   }
   if (spec.rfind("masks:", 0) == 0) {
     const std::string dir = spec.substr(6);
@@ -28,7 +32,7 @@ std::unique_ptr<Segmenter> MakeSegmenter(const std::string& spec, const std::str
     }
     return std::make_unique<MaskDirSegmenter>(dir, "gt");
   }
-  throw InputError("unknown segmenter '" + spec + "' (expected dnn, masks:DIR, gt or none)");
+  throw InputError("unknown segmenter '" + spec + "' (expected dnn, maskrcnn, masks:DIR, gt or none)");
 }
 
 }  // namespace detslam

@@ -11,6 +11,7 @@ namespace detslam {
 
 // spec:
 //   "dnn"        DnnSegmenter with DnnOptionsFromSettings(settings, models_dir)
+//   "maskrcnn"   MaskRcnnSegmenter with MaskRcnnOptionsFromSettings (untested: no weights here)
 //   "masks:DIR"  MaskDirSegmenter reading DIR (mask_dir.h format)
 //   "gt"         MaskDirSegmenter on <dataset_dir>/masks (synthetic sequences' ground truth)
 //   "none"       nullptr (no segmentation)

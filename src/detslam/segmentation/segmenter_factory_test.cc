@@ -54,6 +54,12 @@ TEST(SegmenterFactory, MissingModelsNameEveryPathLookedAt) {
             std::string::npos)
       << e;
   EXPECT_NE(e.find("MISSING"), std::string::npos) << e;
+  const std::string m =
+      ErrorOf([&] { MakeSegmenter("maskrcnn", "", settings, "/nonexistent/models"); });
+  EXPECT_NE(m.find("/nonexistent/models/mask_rcnn_inception_v2_coco/frozen_inference_graph.pb"),
+            std::string::npos)
+      << m;
+  EXPECT_NE(m.find(".pbtxt (MISSING)"), std::string::npos) << m;
 }
 
 TEST(DnnOptions, FromSettingsResolvesCompanionsAndClasses) {
