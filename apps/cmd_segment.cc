@@ -39,11 +39,12 @@ void Segment(const SegmentArgs& a) {
   }
   if (a.no_person_mask) options.person_mask_model.clear();
   DnnSegmenter segmenter(options);
-  const size_t n = a.max_frames >= 0 ? std::min<size_t>(dataset.size(), a.max_frames) : dataset.size();
+  const size_t n =
+      a.max_frames >= 0 ? std::min<size_t>(dataset.size(), a.max_frames) : dataset.size();
   std::fprintf(stderr, "detslam segment: %zu frames from %s with %s -> %s\n", n,
                dataset.dir().c_str(), segmenter.name().c_str(), a.out.c_str());
-  MaskDirWriter writer(a.out, "made by detslam segment (" + segmenter.name() + ") from " +
-                                  dataset.dir());
+  MaskDirWriter writer(a.out,
+                       "made by detslam segment (" + segmenter.name() + ") from " + dataset.dir());
   double detect_ms = 0, mask_ms = 0;
   const auto start = std::chrono::steady_clock::now();
   for (size_t i = 0; i < n; ++i) {
@@ -67,8 +68,8 @@ void Segment(const SegmentArgs& a) {
   }
   writer.Finish();
   const double frames = std::max<double>(1, n);
-  std::printf("segmented %zu frames: %d instances; mean ms per frame: detect %.1f, masks %.1f\n",
-              n, writer.instances(), detect_ms / frames, mask_ms / frames);
+  std::printf("segmented %zu frames: %d instances; mean ms per frame: detect %.1f, masks %.1f\n", n,
+              writer.instances(), detect_ms / frames, mask_ms / frames);
   std::printf("masks: %s (use: detslam run --segmenter masks:%s)\n", a.out.c_str(), a.out.c_str());
 }
 

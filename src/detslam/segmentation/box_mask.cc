@@ -10,10 +10,14 @@ namespace detslam {
 
 bool DominantDepthOptions::Check(std::string* error) const {
   std::string e;
-  if (!(bin_m > 0)) e = "dominant-depth bin width must be > 0";
-  else if (!(tolerance_m >= 0)) e = "dominant-depth tolerance must be >= 0";
-  else if (min_valid_pixels < 1) e = "dominant-depth min_valid_pixels must be >= 1";
-  else if (!(min_depth_m >= 0 && max_depth_m > min_depth_m)) e = "depth range must be 0 <= min < max";
+  if (!(bin_m > 0))
+    e = "dominant-depth bin width must be > 0";
+  else if (!(tolerance_m >= 0))
+    e = "dominant-depth tolerance must be >= 0";
+  else if (min_valid_pixels < 1)
+    e = "dominant-depth min_valid_pixels must be >= 1";
+  else if (!(min_depth_m >= 0 && max_depth_m > min_depth_m))
+    e = "depth range must be 0 <= min < max";
   if (!e.empty() && error != nullptr) *error = e;
   return e.empty();
 }

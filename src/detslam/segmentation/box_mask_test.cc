@@ -54,7 +54,8 @@ TEST(BoxMask, ToleranceControlsTheDepthWindow) {
   Scene s;
   DominantDepthOptions narrow;
   narrow.tolerance_m = 0.02;
-  const cv::Mat mask = DominantDepthBoxMask(s.depth, cv::Rect(20, 15, 40, 70), s.depth.size(), narrow);
+  const cv::Mat mask =
+      DominantDepthBoxMask(s.depth, cv::Rect(20, 15, 40, 70), s.depth.size(), narrow);
   const int n = cv::countNonZero(mask);
   EXPECT_GT(n, 0);
   EXPECT_LT(n, cv::countNonZero(s.truth) / 2);  // only part of the 0.2 m ramp

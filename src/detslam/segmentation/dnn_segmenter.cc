@@ -31,7 +31,8 @@ double MsSince(Clock::time_point t) {
 }
 
 bool EndsWith(const std::string& s, const std::string& suffix) {
-  return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
+  return s.size() >= suffix.size() &&
+         s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
 }
 
 std::string Trim(const std::string& s) {
@@ -63,12 +64,16 @@ struct DnnSegmenter::Nets {
 
 bool DnnSegmenterOptions::Check(std::string* error) const {
   std::string e;
-  if (detector_path.empty()) e = "no detector model given";
+  if (detector_path.empty())
+    e = "no detector model given";
   else if (!EndsWith(detector_path, ".onnx") && !EndsWith(detector_path, ".cfg"))
     e = "detector must be a YOLOX .onnx or a Darknet .cfg: " + detector_path;
-  else if (!(score_threshold > 0 && score_threshold < 1)) e = "score threshold must be in (0, 1)";
-  else if (!(nms_threshold > 0 && nms_threshold <= 1)) e = "NMS threshold must be in (0, 1]";
-  else if (!(box_expand >= 0 && box_expand <= 1)) e = "box expansion must be in [0, 1]";
+  else if (!(score_threshold > 0 && score_threshold < 1))
+    e = "score threshold must be in (0, 1)";
+  else if (!(nms_threshold > 0 && nms_threshold <= 1))
+    e = "NMS threshold must be in (0, 1]";
+  else if (!(box_expand >= 0 && box_expand <= 1))
+    e = "box expansion must be in [0, 1]";
   else if (yolox_input_size <= 0 || yolox_input_size % 32 != 0)
     e = "YOLOX input size must be a positive multiple of 32";
   else if (darknet_input_size <= 0 || darknet_input_size % 32 != 0)
@@ -118,7 +123,8 @@ DnnSegmenterOptions DnnOptionsFromSettings(const Settings& s, const std::string&
   const std::string mask =
       s.GetString("Segmentation.PersonMask", "selfie_segmentation/selfie_segmentation.onnx");
   o.person_mask_model = (mask == "none" || mask.empty()) ? "" : resolve(mask);
-  o.score_threshold = static_cast<float>(s.GetDouble("Segmentation.ScoreThreshold", o.score_threshold));
+  o.score_threshold =
+      static_cast<float>(s.GetDouble("Segmentation.ScoreThreshold", o.score_threshold));
   o.nms_threshold = static_cast<float>(s.GetDouble("Segmentation.NmsThreshold", o.nms_threshold));
   o.box_expand = s.GetDouble("Segmentation.BoxExpand", o.box_expand);
   o.yolox_input_size = s.GetInt("Segmentation.InputSize", o.yolox_input_size);
@@ -143,9 +149,10 @@ DnnSegmenter::DnnSegmenter(const DnnSegmenterOptions& options)
     for (const std::string& q : looked) {
       all += "\n  " + q + (fs::is_regular_file(q) ? " (found)" : " (MISSING)");
     }
-    throw InputError(p, 0, "model file not found. Looked for:" + all +
-                               "\nPut the models there, set $DETSLAM_MODELS or pass --models DIR "
-                               "(see models/README.md)");
+    throw InputError(p, 0,
+                     "model file not found. Looked for:" + all +
+                         "\nPut the models there, set $DETSLAM_MODELS or pass --models DIR "
+                         "(see models/README.md)");
   }
   darknet_ = EndsWith(options_.detector_path, ".cfg");
   names_ = ReadNames(options_.names_path);
@@ -197,10 +204,10 @@ std::vector<DnnSegmenter::Detection> DnnSegmenter::DetectYolox(const cv::Mat& bg
                                scale, options_.score_threshold);
   std::vector<Detection> dets;
   for (const RawDetection& d : NmsPerClass(raw, options_.score_threshold, options_.nms_threshold)) {
-    const cv::Rect box(cv::Point(static_cast<int>(std::floor(d.box.x)),
-                                 static_cast<int>(std::floor(d.box.y))),
-                       cv::Point(static_cast<int>(std::ceil(d.box.br().x)),
-                                 static_cast<int>(std::ceil(d.box.br().y))));
+    const cv::Rect box(
+        cv::Point(static_cast<int>(std::floor(d.box.x)), static_cast<int>(std::floor(d.box.y))),
+        cv::Point(static_cast<int>(std::ceil(d.box.br().x)),
+                  static_cast<int>(std::ceil(d.box.br().y))));
     dets.push_back({d.class_id, d.score, box});
   }
   return dets;
@@ -210,8 +217,7 @@ std::vector<DnnSegmenter::Detection> DnnSegmenter::DetectDarknet(const cv::Mat& 
   std::vector<int> ids;
   std::vector<float> scores;
   std::vector<cv::Rect> boxes;
-  nets_->darknet->detect(bgr, ids, scores, boxes, options_.score_threshold,
-                         options_.nms_threshold);
+  nets_->darknet->detect(bgr, ids, scores, boxes, options_.score_threshold, options_.nms_threshold);
   std::vector<Detection> dets;
   for (size_t i = 0; i < ids.size(); ++i) dets.push_back({ids[i], scores[i], boxes[i]});
   std::stable_sort(dets.begin(), dets.end(),
@@ -238,9 +244,8 @@ std::vector<Instance> DnnSegmenter::Segment(const SegmenterInput& input) {
     const int coco = CocoClassId(in.class_name);
     in.class_id = coco >= 0 ? coco : d.class_id;
     in.score = d.score;
-    if (!options_.classes.empty() &&
-        std::find(options_.classes.begin(), options_.classes.end(), in.class_name) ==
-            options_.classes.end()) {
+    if (!options_.classes.empty() && std::find(options_.classes.begin(), options_.classes.end(),
+                                               in.class_name) == options_.classes.end()) {
       continue;
     }
     if (in.class_id == 0 && person_mask_) {

@@ -17,17 +17,17 @@ namespace detslam {
 class PersonMaskModel;
 
 struct DnnSegmenterOptions {
-  std::string detector_path;      // .onnx (YOLOX) or .cfg (Darknet, with weights_path)
-  std::string weights_path;       // Darknet weights; empty = detector path with .weights
-  std::string names_path;         // class names, one per line; empty = coco.names beside the
-                                  // detector (body.names for a *_body.cfg)
-  std::string person_mask_model;  // selfie_segmentation.onnx; empty = box (depth) masks only
-  float score_threshold = 0.35f;  // minimum detection score (obj * class for YOLOX)
-  float nms_threshold = 0.45f;    // IoU above which same-class boxes are suppressed
-  double box_expand = 0.10;       // person box grown by this fraction per side for the mask crop
+  std::string detector_path;         // .onnx (YOLOX) or .cfg (Darknet, with weights_path)
+  std::string weights_path;          // Darknet weights; empty = detector path with .weights
+  std::string names_path;            // class names, one per line; empty = coco.names beside the
+                                     // detector (body.names for a *_body.cfg)
+  std::string person_mask_model;     // selfie_segmentation.onnx; empty = box (depth) masks only
+  float score_threshold = 0.35f;     // minimum detection score (obj * class for YOLOX)
+  float nms_threshold = 0.45f;       // IoU above which same-class boxes are suppressed
+  double box_expand = 0.10;          // person box grown by this fraction per side for the mask crop
   std::vector<std::string> classes;  // class names to return; empty = all
-  int yolox_input_size = 416;     // square input of the YOLOX export (multiple of 32)
-  int darknet_input_size = 320;   // square input of the Darknet model
+  int yolox_input_size = 416;        // square input of the YOLOX export (multiple of 32)
+  int darknet_input_size = 320;      // square input of the Darknet model
   float person_mask_threshold = 0.5f;  // selfie probability above which a pixel is person
   DominantDepthOptions depth_mask;     // masks of classes without a mask model
 

@@ -64,8 +64,7 @@ std::vector<Instance> RunTimed(DnnSegmenter* seg, const SegmenterInput& input, c
     det.push_back(seg->last_timings().detect_ms);
     mask.push_back(seg->last_timings().mask_ms);
   }
-  ::testing::Test::RecordProperty(std::string(tag) + "_detect_ms",
-                                  std::to_string(Mean(det)));
+  ::testing::Test::RecordProperty(std::string(tag) + "_detect_ms", std::to_string(Mean(det)));
   ::testing::Test::RecordProperty(std::string(tag) + "_mask_ms", std::to_string(Mean(mask)));
   spdlog::info("{}: detect {:.1f} ms, masks {:.1f} ms per frame ({} instances)", tag, Mean(det),
                Mean(mask), out.size());
@@ -97,8 +96,8 @@ TEST(DataDnnSegmenter, YoloxAndSelfieMasksMatchTheTwoReferencePeople) {
       }
     }
     RecordProperty("mask_iou_person_" + std::to_string(best_id), std::to_string(best));
-    spdlog::info("person score {:.2f} box {}x{}+{}+{}: mask IoU {:.3f} with reference {}",
-                 p.score, p.box.width, p.box.height, p.box.x, p.box.y, best, best_id);
+    spdlog::info("person score {:.2f} box {}x{}+{}+{}: mask IoU {:.3f} with reference {}", p.score,
+                 p.box.width, p.box.height, p.box.x, p.box.y, best, best_id);
     EXPECT_GE(best, 0.8) << "person at " << p.box;
     matched.push_back(best_id);
   }
@@ -109,7 +108,7 @@ void ExpectBothPeopleBoxes(const std::string& cfg, const char* tag) {
   const ClipFrame f = LoadClip();
   DnnSegmenterOptions o;
   o.detector_path = SharedPath(cfg);  // weights and names found beside the cfg
-  DnnSegmenter seg(o);                 // no person mask model: box/depth masks
+  DnnSegmenter seg(o);                // no person mask model: box/depth masks
   const auto people = People(RunTimed(&seg, f.input, tag));
   ASSERT_GE(people.size(), 2u);
   for (int id = 1; id <= 2; ++id) {

@@ -67,7 +67,8 @@ std::map<int64_t, std::vector<MaskRecord>> ReadInstanceList(const std::string& p
       r.class_id = CocoClassId(r.class_name);
     }
     const double score = ParseDoubleField(path, line, f[k++]);
-    if (score < 0 || score > 1) throw InputError(path, line, "score must be in [0, 1], got " + f[k - 1]);
+    if (score < 0 || score > 1)
+      throw InputError(path, line, "score must be in [0, 1], got " + f[k - 1]);
     r.score = static_cast<float>(score);
     int v[4];
     for (int i = 0; i < 4; ++i) v[i] = ParseIntField(path, line, f[k++], "box coordinate");
@@ -143,9 +144,9 @@ std::vector<Instance> MaskDirSegmenter::Segment(const SegmenterInput& input) {
       }
       for (size_t v = 1; v < seen.size(); ++v) {
         if (seen[v] && !listed.count(static_cast<int>(v))) {
-          throw InputError(png, 0, "holds instance id " + std::to_string(v) +
-                                       " that " + dir_ + "/instances.txt does not list for " +
-                                       input.stamp.ToString());
+          throw InputError(png, 0,
+                           "holds instance id " + std::to_string(v) + " that " + dir_ +
+                               "/instances.txt does not list for " + input.stamp.ToString());
         }
       }
     }
@@ -192,8 +193,8 @@ void MaskDirWriter::Add(Timestamp stamp, const cv::Size& size,
     const Instance& in = instances[k];
     std::ostringstream os;
     os << stamp.ToString() << " " << k + 1 << " " << in.class_id << " "
-       << NameToField(in.class_name) << " " << in.score << " " << in.box.x << " " << in.box.y
-       << " " << in.box.width << " " << in.box.height;
+       << NameToField(in.class_name) << " " << in.score << " " << in.box.x << " " << in.box.y << " "
+       << in.box.width << " " << in.box.height;
     lines_.push_back(os.str());
   }
 }

@@ -31,9 +31,9 @@ namespace detslam {
 
 // One line of instances.txt.
 struct MaskRecord {
-  Timestamp stamp;      // colour image stamp
-  int id = 0;           // value of the instance's pixels in <stamp>.png
-  int class_id = -1;    // COCO class index, -1 unknown
+  Timestamp stamp;    // colour image stamp
+  int id = 0;         // value of the instance's pixels in <stamp>.png
+  int class_id = -1;  // COCO class index, -1 unknown
   std::string class_name;
   float score = 1.0f;
   cv::Rect box;

@@ -17,15 +17,13 @@ class MaskDirTest : public ::testing::Test {
  protected:
   void SetUp() override {
     dir_ = fs::temp_directory_path() /
-           ("detslam_maskdir_" + std::string(::testing::UnitTest::GetInstance()
-                                                 ->current_test_info()->name()));
+           ("detslam_maskdir_" +
+            std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
     fs::remove_all(dir_);
     fs::create_directories(dir_);
   }
   void TearDown() override { fs::remove_all(dir_); }
-  void WriteList(const std::string& text) {
-    std::ofstream(dir_ / "instances.txt") << text;
-  }
+  void WriteList(const std::string& text) { std::ofstream(dir_ / "instances.txt") << text; }
   SegmenterInput Frame(const std::string& stamp, cv::Size size = cv::Size(64, 48)) {
     SegmenterInput in;
     EXPECT_TRUE(ParseTimestamp(stamp, &in.stamp));
@@ -102,8 +100,9 @@ TEST_F(MaskDirTest, WriteThenReadRoundTrip) {
 TEST_F(MaskDirTest, HigherScoreWinsWhereMasksOverlap) {
   const cv::Size size(64, 48);
   const Timestamp t{1000000000};
-  std::vector<Instance> in = {MakeInstance(0, "person", 0.4f, cv::Rect(0, 0, 30, 30), size, false),
-                              MakeInstance(0, "person", 0.8f, cv::Rect(20, 0, 30, 30), size, false)};
+  std::vector<Instance> in = {
+      MakeInstance(0, "person", 0.4f, cv::Rect(0, 0, 30, 30), size, false),
+      MakeInstance(0, "person", 0.8f, cv::Rect(20, 0, 30, 30), size, false)};
   WriteMasks(dir_.string(), {t}, {in}, size);
   const auto got = MaskDirSegmenter(dir_.string()).Segment(Frame(t.ToString()));
   ASSERT_EQ(got.size(), 2u);
@@ -112,8 +111,9 @@ TEST_F(MaskDirTest, HigherScoreWinsWhereMasksOverlap) {
 }
 
 TEST_F(MaskDirTest, ReadsTheSynthGeneratorsEightFieldLines) {
-  WriteList("# timestamp id class score x y w h\n1.000000 1 person 1 2 3 4 5\n"
-            "1.000000 2 bicycle 1 10 10 2 2\n");
+  WriteList(
+      "# timestamp id class score x y w h\n1.000000 1 person 1 2 3 4 5\n"
+      "1.000000 2 bicycle 1 10 10 2 2\n");
   cv::Mat ids(48, 64, CV_16UC1, cv::Scalar(0));
   ids(cv::Rect(2, 3, 4, 5)).setTo(1);
   ids(cv::Rect(10, 10, 2, 2)).setTo(2);

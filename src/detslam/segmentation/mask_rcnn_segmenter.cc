@@ -16,8 +16,10 @@ bool MaskRcnnOptions::Check(std::string* error) const {
   std::string e;
   if (graph_path.empty() || config_path.empty() || names_path.empty())
     e = "Mask R-CNN needs a graph (.pb), a config (.pbtxt) and a class names file";
-  else if (!(score_threshold > 0 && score_threshold < 1)) e = "score threshold must be in (0, 1)";
-  else if (!(mask_threshold > 0 && mask_threshold < 1)) e = "mask threshold must be in (0, 1)";
+  else if (!(score_threshold > 0 && score_threshold < 1))
+    e = "score threshold must be in (0, 1)";
+  else if (!(mask_threshold > 0 && mask_threshold < 1))
+    e = "mask threshold must be in (0, 1)";
   if (!e.empty() && error != nullptr) *error = e;
   return e.empty();
 }
@@ -56,9 +58,10 @@ MaskRcnnSegmenter::MaskRcnnSegmenter(const MaskRcnnOptions& options) : options_(
     for (const std::string& q : files) {
       all += "\n  " + q + (fs::is_regular_file(q) ? " (found)" : " (MISSING)");
     }
-    throw InputError(p, 0, "Mask R-CNN model file not found. Looked for:" + all +
-                               "\n(mask_rcnn_inception_v2_coco from the TensorFlow detection model "
-                               "zoo with OpenCV's .pbtxt; or use --segmenter dnn)");
+    throw InputError(p, 0,
+                     "Mask R-CNN model file not found. Looked for:" + all +
+                         "\n(mask_rcnn_inception_v2_coco from the TensorFlow detection model "
+                         "zoo with OpenCV's .pbtxt; or use --segmenter dnn)");
   }
   std::ifstream in(options_.names_path);
   std::string line;
@@ -79,7 +82,8 @@ std::vector<Instance> MaskRcnnSegmenter::Segment(const SegmenterInput& input) {
   if (input.bgr.empty() || input.bgr.type() != CV_8UC3) {
     throw InputError("frame " + input.stamp.ToString() + ": segmenter needs an 8-bit BGR image");
   }
-  const cv::Mat blob = cv::dnn::blobFromImage(input.bgr, 1.0, cv::Size(), cv::Scalar(), true, false);
+  const cv::Mat blob =
+      cv::dnn::blobFromImage(input.bgr, 1.0, cv::Size(), cv::Scalar(), true, false);
   net_.setInput(blob);
   std::vector<cv::Mat> outs;
   net_.forward(outs, std::vector<std::string>{"detection_out_final", "detection_masks"});
@@ -106,9 +110,8 @@ std::vector<Instance> MaskRcnnSegmenter::Segment(const SegmenterInput& input) {
                        static_cast<int>(rows.at<float>(i, 6) * size.height));
     in.box = cv::Rect(tl, br) & image;
     if (in.box.empty()) continue;
-    if (!options_.classes.empty() &&
-        std::find(options_.classes.begin(), options_.classes.end(), in.class_name) ==
-            options_.classes.end()) {
+    if (!options_.classes.empty() && std::find(options_.classes.begin(), options_.classes.end(),
+                                               in.class_name) == options_.classes.end()) {
       continue;
     }
     cv::Mat small(mh, mw, CV_32F, const_cast<float*>(masks.ptr<float>(i, cls)));

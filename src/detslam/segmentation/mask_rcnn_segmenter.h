@@ -15,21 +15,23 @@
 namespace detslam {
 
 struct MaskRcnnOptions {
-  std::string graph_path;         // frozen_inference_graph.pb
-  std::string config_path;        // OpenCV's mask_rcnn_inception_v2_coco_2018_01_28.pbtxt
-  std::string names_path;         // class names, line k = network class id k (90-class TF list)
-  float score_threshold = 0.5f;   // minimum detection score
-  float mask_threshold = 0.3f;    // mask probability above which a pixel belongs to the object
+  std::string graph_path;            // frozen_inference_graph.pb
+  std::string config_path;           // OpenCV's mask_rcnn_inception_v2_coco_2018_01_28.pbtxt
+  std::string names_path;            // class names, line k = network class id k (90-class TF list)
+  float score_threshold = 0.5f;      // minimum detection score
+  float mask_threshold = 0.3f;       // mask probability above which a pixel belongs to the object
   std::vector<std::string> classes;  // class names to return; empty = all
 
   bool Check(std::string* error) const;
 };
 
 // Keys Segmentation.MaskRcnnGraph, Segmentation.MaskRcnnConfig, Segmentation.MaskRcnnNames
-// (relative paths resolve against models_dir; defaults in <models_dir>/mask_rcnn_inception_v2_coco/:
-// frozen_inference_graph.pb, mask_rcnn_inception_v2_coco_2018_01_28.pbtxt,
-// object_detection_classes_coco.txt), Segmentation.ScoreThreshold, Segmentation.DynamicClasses.
-MaskRcnnOptions MaskRcnnOptionsFromSettings(const Settings& settings, const std::string& models_dir);
+// (relative paths resolve against models_dir; defaults in
+// <models_dir>/mask_rcnn_inception_v2_coco/: frozen_inference_graph.pb,
+// mask_rcnn_inception_v2_coco_2018_01_28.pbtxt, object_detection_classes_coco.txt),
+// Segmentation.ScoreThreshold, Segmentation.DynamicClasses.
+MaskRcnnOptions MaskRcnnOptionsFromSettings(const Settings& settings,
+                                            const std::string& models_dir);
 
 class MaskRcnnSegmenter : public Segmenter {
  public:

@@ -39,8 +39,9 @@ cv::Mat PersonMaskModel::Probability(const cv::Mat& bgr, const cv::Rect& roi) {
   net_.setInput(blob);
   cv::Mat out = net_.forward();
   if (out.total() != static_cast<size_t>(kSide * kSide)) {
-    throw InputError(path_, 0, "unexpected output size " + std::to_string(out.total()) +
-                                   " (expected 256x256x1)");
+    throw InputError(
+        path_, 0,
+        "unexpected output size " + std::to_string(out.total()) + " (expected 256x256x1)");
   }
   cv::Mat prob(kSide, kSide, CV_32F, out.ptr<float>());
   cv::Mat back;

@@ -32,7 +32,8 @@ std::unique_ptr<Segmenter> MakeSegmenter(const std::string& spec, const std::str
     }
     return std::make_unique<MaskDirSegmenter>(dir, "gt");
   }
-  throw InputError("unknown segmenter '" + spec + "' (expected dnn, maskrcnn, masks:DIR, gt or none)");
+  throw InputError("unknown segmenter '" + spec +
+                   "' (expected dnn, maskrcnn, masks:DIR, gt or none)");
 }
 
 }  // namespace detslam

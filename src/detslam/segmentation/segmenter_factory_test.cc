@@ -46,8 +46,7 @@ TEST(SegmenterFactory, NoneGtMasksAndUnknown) {
 
 TEST(SegmenterFactory, MissingModelsNameEveryPathLookedAt) {
   Settings settings;
-  const std::string e =
-      ErrorOf([&] { MakeSegmenter("dnn", "", settings, "/nonexistent/models"); });
+  const std::string e = ErrorOf([&] { MakeSegmenter("dnn", "", settings, "/nonexistent/models"); });
   EXPECT_NE(e.find("/nonexistent/models/yolox_nano/yolox_nano.onnx"), std::string::npos) << e;
   EXPECT_NE(e.find("/nonexistent/models/yolox_nano/coco.names"), std::string::npos) << e;
   EXPECT_NE(e.find("/nonexistent/models/selfie_segmentation/selfie_segmentation.onnx"),

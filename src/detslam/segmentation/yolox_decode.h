@@ -10,9 +10,9 @@ namespace detslam {
 
 // One decoded detection in original-image pixels (not yet clipped).
 struct RawDetection {
-  int class_id = 0;   // index into the model's class list
-  float score = 0;    // objectness * class score
-  cv::Rect2d box;     // x, y, width, height in original-image pixels
+  int class_id = 0;  // index into the model's class list
+  float score = 0;   // objectness * class score
+  cv::Rect2d box;    // x, y, width, height in original-image pixels
 };
 
 // Letterbox as YOLOX's demo does it: the image scaled by r = min(S / w, S / h) (bilinear), placed

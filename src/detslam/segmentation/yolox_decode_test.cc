@@ -8,7 +8,7 @@
 namespace detslam {
 namespace {
 
-constexpr int kSide = 64;     // 8x8 + 4x4 + 2x2 = 84 cells
+constexpr int kSide = 64;  // 8x8 + 4x4 + 2x2 = 84 cells
 constexpr int kClasses = 3;
 constexpr int kCols = 5 + kClasses;
 
@@ -67,9 +67,9 @@ TEST(YoloxDecode, DecodesGridOffsetsSizesAndLetterboxScale) {
 TEST(YoloxDecode, NmsSuppressesOnlyWithinAClass) {
   std::vector<RawDetection> in = {
       {0, 0.6f, cv::Rect2d(10, 10, 100, 200)},
-      {0, 0.9f, cv::Rect2d(12, 8, 100, 200)},    // same class, IoU ~0.94: keeps the 0.9 one
-      {1, 0.5f, cv::Rect2d(11, 9, 100, 200)},    // other class, same place: kept
-      {0, 0.4f, cv::Rect2d(300, 10, 50, 50)},    // same class, disjoint: kept
+      {0, 0.9f, cv::Rect2d(12, 8, 100, 200)},  // same class, IoU ~0.94: keeps the 0.9 one
+      {1, 0.5f, cv::Rect2d(11, 9, 100, 200)},  // other class, same place: kept
+      {0, 0.4f, cv::Rect2d(300, 10, 50, 50)},  // same class, disjoint: kept
   };
   const auto out = NmsPerClass(in, 0.35f, 0.45f);
   ASSERT_EQ(out.size(), 3u);
