@@ -10,6 +10,8 @@
 #include "detslam/io/dataset.h"
 #include "detslam/io/settings.h"
 #include "detslam/pipeline/runner.h"
+#include "detslam/segmentation/dnn_segmenter.h"
+#include "detslam/segmentation/segmenter_factory.h"
 
 namespace detslam::app {
 namespace {
@@ -23,6 +25,11 @@ struct RunArgs {
   int64_t max_frames = -1;
   double max_dt = 0.02;
   bool no_progress = false;
+  bool threaded = false;
+  std::string segmenter;  // empty: dnn if the models are found, else none
+  std::string models;
+  double alpha = -1;
+  bool no_depth_step = false;
 };
 
 // A one-line progress bar on stderr when it is a terminal; otherwise a log line every 100 frames.
@@ -58,15 +65,33 @@ void Run(const RunArgs& a) {
   RunOptions options;
   options.out_dir = a.out;
   options.max_frames = a.max_frames;
+  options.threaded = a.threaded;
   options.slam = SlamOptionsFromSettings(settings, a.seed);
+  if (a.alpha >= 0) options.slam.dynamic.alpha = a.alpha;
+  if (a.no_depth_step) options.slam.dynamic.depth_step = false;
   std::string error;
   if (!options.slam.Check(&error)) throw InputError(settings.source, 0, error);
-  std::printf("detslam run: %zu frames from %s (settings: %s)\n", dataset.size(), dataset.dir().c_str(),
+  const std::string models_dir = a.models.empty() ? DefaultModelsDir() : a.models;
+  std::string spec = a.segmenter;
+  std::unique_ptr<Segmenter> segmenter;
+  if (spec.empty()) {
+    try {
+      segmenter = MakeSegmenter("dnn", a.dataset, settings, models_dir);
+      spec = "dnn";
+    } catch (const InputError& e) {
+      std::fprintf(stderr, "note: no dynamic-object segmentation (pass --segmenter dnn|masks:DIR|gt|none): %s\n", e.what());
+      spec = "none";
+    }
+  } else {
+    segmenter = MakeSegmenter(spec, a.dataset, settings, models_dir);
+  }
+  std::printf("detslam run (%s, segmenter %s): %zu frames from %s (settings: %s)\n", a.threaded ? "threaded" : "sequential", spec.c_str(), dataset.size(), dataset.dir().c_str(),
               settings.source.c_str());
   ProgressBar bar(!a.no_progress);
-  const RunSummary s = RunSequential(dataset, settings, options, [&](size_t d, size_t t, const FrameReport& r) { bar.Update(d, t, r); });
+  const RunSummary s = Run(dataset, settings, options, [&](size_t d, size_t t, const FrameReport& r) { bar.Update(d, t, r); }, segmenter.get());
   std::printf("tracked %zu/%zu frames (%.1f%%), %zu keyframes, %zu map points, %zu relocalisations\n",
               s.tracked, s.frames, 100.0 * s.TrackedFraction(), s.keyframes, s.landmarks, s.relocalizations);
+  if (!s.segmenter.empty()) std::printf("segmentation (%s): median %.1f ms per frame\n", s.segmenter.c_str(), s.segmentation.median_ms);
   std::printf("median ms per frame: extraction %.1f, tracking %.1f, total %.1f; local mapping %.1f per keyframe\n",
               s.extraction.median_ms, s.tracking.median_ms, s.total.median_ms, s.mapping.median_ms);
   const fs::path out(a.out);
@@ -90,6 +115,12 @@ void AddRunCommand(CLI::App& app) {
   cmd->add_option("--max-dt", args->max_dt, "rgb/depth association window in seconds")->capture_default_str();
   cmd->add_option("--seed", args->seed, "Seed for RANSAC (runs are deterministic per seed)")->capture_default_str();
   cmd->add_option("--max-frames", args->max_frames, "Stop after N frames");
+  cmd->add_option("--segmenter", args->segmenter,
+                  "Dynamic objects: dnn (detector + person masks), masks:DIR (precomputed), gt (synthetic ground truth), none; default dnn when its models are found");
+  cmd->add_option("--models", args->models, "Models folder for --segmenter dnn (default $DETSLAM_MODELS or ../shared/models)");
+  cmd->add_option("--alpha", args->alpha, "Det-SLAM depth-step widening factor alpha (default from settings Dynamic.Alpha, else 0.1)");
+  cmd->add_flag("--no-depth-step", args->no_depth_step, "Mask step only (no depth-ROI step)");
+  cmd->add_flag("--threaded", args->threaded, "Load and extract features in a second thread (same trajectory, faster)");
   cmd->add_flag("--no-progress", args->no_progress, "No progress bar");
   cmd->callback([args] { Run(*args); });
 }

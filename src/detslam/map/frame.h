@@ -40,7 +40,10 @@ struct FrameFeatures {
   std::vector<float> depth;              // metres, <= 0 when unknown
   std::vector<float> u_right;            // u - bf/depth, < 0 when unknown
   cv::Mat descriptors;                   // N x 32, CV_8UC1
-  std::vector<KeypointLabel> labels;     // dynamic-filter label per keypoint (all kStatic if none)
+  std::vector<KeypointLabel> labels;     // label per keypoint: all kStatic (rejected ones below)
+  // Keypoints the dynamic filter rejected, kept for diagnostics only (tracking never sees them).
+  std::vector<cv::KeyPoint> rejected_keypoints;
+  std::vector<KeypointLabel> rejected_labels;
   std::shared_ptr<const KeypointGrid> grid;  // area queries over `undist`
 
   size_t size() const { return keypoints.size(); }

@@ -7,9 +7,12 @@
 #include <filesystem>
 #include <nlohmann/json.hpp>
 #include <numeric>
+#include <functional>
+#include <thread>
 
 #include "detslam/core/atomic_file.h"
 #include "detslam/io/ply.h"
+#include "detslam/pipeline/bounded_queue.h"
 
 namespace detslam {
 namespace {
@@ -35,7 +38,7 @@ void WriteOutputs(const RgbdDataset& dataset, const Settings& settings, const Ru
   nlohmann::json j;
   j["dataset"] = dataset.dir();
   j["settings"] = settings.source;
-  j["mode"] = "sequential";
+  j["mode"] = options.threaded ? "threaded" : "sequential";
   j["camera"] = {{"fx", settings.camera.fx}, {"fy", settings.camera.fy}, {"cx", settings.camera.cx},
                  {"cy", settings.camera.cy}, {"depth_map_factor", settings.camera.depth_map_factor},
                  {"bf", settings.camera.bf}, {"th_depth", settings.camera.th_depth}};
@@ -50,14 +53,20 @@ void WriteOutputs(const RgbdDataset& dataset, const Settings& settings, const Ru
   j["map_points"] = summary.landmarks;
   j["relocalizations"] = summary.relocalizations;
   j["wall_s"] = summary.wall_s;
-  j["timings"] = {{"extraction", StatsJson(summary.extraction)}, {"tracking", StatsJson(summary.tracking)},
+  j["segmenter"] = summary.segmenter.empty() ? "none" : summary.segmenter;
+  j["dynamic_filter"] = {{"classes", options.slam.dynamic.dynamic_classes}, {"alpha", options.slam.dynamic.alpha},
+                         {"depth_step", options.slam.dynamic.depth_step}, {"mask_dilation_px", options.slam.dynamic.mask_dilation_px},
+                         {"premask", options.slam.dynamic_premask}};
+  j["timings"] = {{"segmentation", StatsJson(summary.segmentation)}, {"extraction", StatsJson(summary.extraction)}, {"tracking", StatsJson(summary.tracking)},
                   {"local_mapping_per_keyframe", StatsJson(summary.mapping)}, {"total_per_frame", StatsJson(summary.total)}};
   nlohmann::json per_frame = nlohmann::json::array();
   for (const FrameReport& r : summary.reports) {
     per_frame.push_back({{"index", r.index}, {"stamp", r.stamp.Seconds()}, {"state", ToString(r.tracking.state)},
                          {"tracked", r.tracking.pose_valid}, {"method", r.tracking.method},
                          {"inliers", r.tracking.num_inliers}, {"keyframe", r.keyframe},
-                         {"keypoints", r.num_keypoints}, {"extraction_ms", r.timings.extraction_ms},
+                         {"keypoints", r.num_keypoints}, {"dynamic_instances", r.dynamic_instances},
+                         {"rejected_keypoints", r.rejected_keypoints}, {"segmentation_ms", r.segmentation_ms},
+                         {"extraction_ms", r.timings.extraction_ms},
                          {"tracking_ms", r.timings.tracking_ms}, {"mapping_ms", r.timings.mapping_ms}});
   }
   j["per_frame"] = per_frame;
@@ -77,6 +86,24 @@ SlamOptions SlamOptionsFromSettings(const Settings& settings, uint64_t seed) {
   o.tracker.max_frames_between_keyframes = std::max(1, static_cast<int>(std::lround(settings.camera.fps)));
   o.mapper.local_ba = settings.GetBool("LocalMapping.BundleAdjustment", o.mapper.local_ba);
   o.mapper.max_local_keyframes = settings.GetInt("LocalMapping.MaxLocalKeyFrames", o.mapper.max_local_keyframes);
+  o.dynamic.alpha = settings.GetDouble("Dynamic.Alpha", o.dynamic.alpha);
+  o.dynamic.depth_step = settings.GetBool("Dynamic.DepthStep", o.dynamic.depth_step);
+  o.dynamic.mask_dilation_px = settings.GetInt("Dynamic.MaskDilation", o.dynamic.mask_dilation_px);
+  o.dynamic.min_score = static_cast<float>(settings.GetDouble("Dynamic.MinScore", o.dynamic.min_score));
+  o.dynamic_premask = settings.GetBool("Dynamic.PreMask", o.dynamic_premask);
+  const std::string classes = settings.GetString("Dynamic.Classes", "");
+  if (!classes.empty()) {
+    o.dynamic.dynamic_classes.clear();
+    std::string cur;
+    for (char c : classes + ",") {
+      if (c == ',') {
+        if (!cur.empty()) o.dynamic.dynamic_classes.push_back(cur);
+        cur.clear();
+      } else if (c != ' ') {
+        cur.push_back(c);
+      }
+    }
+  }
   return o;
 }
 
@@ -92,36 +119,178 @@ StageStats ComputeStageStats(std::vector<double> v) {
   return s;
 }
 
-RunSummary RunSequential(const RgbdDataset& dataset, const Settings& settings,
-                         const RunOptions& options, const ProgressFn& progress) {
-  const auto t_start = std::chrono::steady_clock::now();
-  SlamSystem slam(settings.camera, options.slam);
-  RunSummary summary;
+namespace {
+
+// Collects per-frame reports and turns them into the summary and the output files.
+class RunRecorder {
+ public:
+  RunRecorder(size_t total, const ProgressFn& progress) : total_(total), progress_(progress) {}
+
+  void Add(const FrameReport& r) {
+    ++summary_.frames;
+    if (r.tracking.pose_valid) ++summary_.tracked;
+    if (r.tracking.relocalized) ++summary_.relocalizations;
+    if (r.segmentation_ms > 0) seg_.push_back(r.segmentation_ms);
+    ext_.push_back(r.timings.extraction_ms);
+    trk_.push_back(r.timings.tracking_ms);
+    if (r.keyframe) map_.push_back(r.timings.mapping_ms);
+    total_ms_.push_back(r.segmentation_ms + r.timings.extraction_ms + r.timings.tracking_ms + r.timings.mapping_ms);
+    summary_.reports.push_back(r);
+    if (progress_) progress_(summary_.frames, total_, r);
+  }
+
+  RunSummary Finish(const RgbdDataset& dataset, const Settings& settings, const RunOptions& options,
+                    const SlamSystem& slam, std::chrono::steady_clock::time_point start,
+                    const Segmenter* segmenter) {
+    if (segmenter != nullptr) summary_.segmenter = segmenter->name();
+    summary_.segmentation = ComputeStageStats(seg_);
+    summary_.keyframes = slam.map().NumKeyFrames();
+    summary_.landmarks = slam.map().NumLandmarks();
+    summary_.extraction = ComputeStageStats(ext_);
+    summary_.tracking = ComputeStageStats(trk_);
+    summary_.mapping = ComputeStageStats(map_);
+    summary_.total = ComputeStageStats(total_ms_);
+    summary_.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    WriteOutputs(dataset, settings, options, slam, summary_);
+    return summary_;
+  }
+
+ private:
+  size_t total_;
+  ProgressFn progress_;
+  RunSummary summary_;
+  std::vector<double> seg_, ext_, trk_, map_, total_ms_;
+};
+
+size_t FrameCount(const RgbdDataset& dataset, const RunOptions& options) {
   size_t n = dataset.size();
   if (options.max_frames >= 0) n = std::min(n, static_cast<size_t>(options.max_frames));
-  std::vector<double> ext, trk, map_ms, total;
-  for (size_t i = 0; i < n; ++i) {
-    const RgbdImages images = dataset.Load(i, settings.camera);
-    FrameReport r = slam.ProcessFrame(static_cast<int64_t>(i), dataset.frame(i).rgb_stamp, images.gray, images.depth_m);
-    ++summary.frames;
-    if (r.tracking.pose_valid) ++summary.tracked;
-    if (r.tracking.relocalized) ++summary.relocalizations;
-    ext.push_back(r.timings.extraction_ms);
-    trk.push_back(r.timings.tracking_ms);
-    if (r.keyframe) map_ms.push_back(r.timings.mapping_ms);
-    total.push_back(r.timings.extraction_ms + r.timings.tracking_ms + r.timings.mapping_ms);
-    summary.reports.push_back(r);
-    if (progress) progress(i + 1, n, r);
+  return n;
+}
+
+}  // namespace
+
+namespace {
+
+struct LoadedFrame {
+  int64_t index = 0;
+  RgbdImages images;
+  std::vector<Instance> instances;
+  bool segmented = false;
+  double segmentation_ms = 0;
+};
+
+LoadedFrame LoadAndSegment(const RgbdDataset& dataset, const Settings& settings, size_t i,
+                           Segmenter* segmenter) {
+  LoadedFrame f;
+  f.index = static_cast<int64_t>(i);
+  f.images = dataset.Load(i, settings.camera);
+  if (segmenter != nullptr) {
+    const auto t0 = std::chrono::steady_clock::now();
+    SegmenterInput in;
+    in.index = f.index;
+    in.stamp = dataset.frame(i).rgb_stamp;
+    in.bgr = f.images.bgr;
+    in.depth_m = f.images.depth_m;
+    f.instances = segmenter->Segment(in);
+    f.segmented = true;
+    f.segmentation_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   }
-  summary.keyframes = slam.map().NumKeyFrames();
-  summary.landmarks = slam.map().NumLandmarks();
-  summary.extraction = ComputeStageStats(ext);
-  summary.tracking = ComputeStageStats(trk);
-  summary.mapping = ComputeStageStats(map_ms);
-  summary.total = ComputeStageStats(total);
-  summary.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
-  WriteOutputs(dataset, settings, options, slam, summary);
-  return summary;
+  return f;
+}
+
+Frame Extract(const SlamSystem& slam, const RgbdDataset& dataset, const LoadedFrame& f, FrameReport* report) {
+  report->segmentation_ms = f.segmentation_ms;
+  return slam.ExtractFrame(f.index, dataset.frame(static_cast<size_t>(f.index)).rgb_stamp, f.images.gray,
+                           f.images.depth_m, cv::Mat(), report, f.segmented ? &f.instances : nullptr);
+}
+
+// Runs `body` in a thread that feeds `queue` and closes it at the end (or on error, keeping the
+// exception for the consumer).
+template <typename Fn>
+std::thread Producer(Fn body, std::exception_ptr* error, std::function<void()> close) {
+  return std::thread([body, error, close] {
+    try {
+      body();
+    } catch (...) {
+      *error = std::current_exception();
+    }
+    close();
+  });
+}
+
+}  // namespace
+
+RunSummary RunSequential(const RgbdDataset& dataset, const Settings& settings,
+                         const RunOptions& options, const ProgressFn& progress,
+                         Segmenter* segmenter) {
+  const auto start = std::chrono::steady_clock::now();
+  SlamSystem slam(settings.camera, options.slam);
+  const size_t n = FrameCount(dataset, options);
+  RunRecorder recorder(n, progress);
+  for (size_t i = 0; i < n; ++i) {
+    const LoadedFrame loaded = LoadAndSegment(dataset, settings, i, segmenter);
+    FrameReport report;
+    Frame frame = Extract(slam, dataset, loaded, &report);
+    slam.TrackFrame(std::move(frame), &report);
+    recorder.Add(report);
+  }
+  return recorder.Finish(dataset, settings, options, slam, start, segmenter);
+}
+
+RunSummary RunThreaded(const RgbdDataset& dataset, const Settings& settings,
+                       const RunOptions& options, const ProgressFn& progress,
+                       Segmenter* segmenter) {
+  const auto start = std::chrono::steady_clock::now();
+  SlamSystem slam(settings.camera, options.slam);
+  const size_t n = FrameCount(dataset, options);
+  RunRecorder recorder(n, progress);
+  struct Extracted {
+    Frame frame;
+    FrameReport report;
+  };
+  BoundedQueue<LoadedFrame> loaded(options.queue_capacity);
+  BoundedQueue<Extracted> extracted(options.queue_capacity);
+  std::exception_ptr load_error, extract_error;
+  std::thread loader = Producer(
+      [&] {
+        for (size_t i = 0; i < n; ++i) {
+          if (!loaded.Push(LoadAndSegment(dataset, settings, i, segmenter))) break;
+        }
+      },
+      &load_error, [&] { loaded.Close(); });
+  std::thread extractor = Producer(
+      [&] {
+        while (std::optional<LoadedFrame> f = loaded.Pop()) {
+          Extracted e;
+          e.frame = Extract(slam, dataset, *f, &e.report);
+          if (!extracted.Push(std::move(e))) break;
+        }
+      },
+      &extract_error, [&] { extracted.Close(); loaded.Close(); });
+  std::exception_ptr track_error;
+  try {
+    while (std::optional<Extracted> e = extracted.Pop()) {
+      slam.TrackFrame(std::move(e->frame), &e->report);
+      recorder.Add(e->report);
+    }
+  } catch (...) {
+    track_error = std::current_exception();
+    extracted.Close();
+    loaded.Close();
+  }
+  loader.join();
+  extractor.join();
+  for (const std::exception_ptr& err : {track_error, load_error, extract_error}) {
+    if (err) std::rethrow_exception(err);
+  }
+  return recorder.Finish(dataset, settings, options, slam, start, segmenter);
+}
+
+RunSummary Run(const RgbdDataset& dataset, const Settings& settings, const RunOptions& options,
+               const ProgressFn& progress, Segmenter* segmenter) {
+  return options.threaded ? RunThreaded(dataset, settings, options, progress, segmenter)
+                          : RunSequential(dataset, settings, options, progress, segmenter);
 }
 
 }  // namespace detslam

@@ -10,12 +10,15 @@
 #include "detslam/io/dataset.h"
 #include "detslam/io/settings.h"
 #include "detslam/pipeline/slam_system.h"
+#include "detslam/segmentation/segmenter.h"
 
 namespace detslam {
 
 struct RunOptions {
   std::string out_dir = "out";  // where outputs go (created)
   int64_t max_frames = -1;      // stop after this many frames (< 0: all)
+  bool threaded = false;        // loading + extraction in a second thread (same results)
+  size_t queue_capacity = 4;    // frames buffered between the threaded stages
   SlamOptions slam;
 };
 
@@ -33,7 +36,8 @@ struct RunSummary {
   size_t landmarks = 0;
   size_t relocalizations = 0;
   double wall_s = 0;
-  StageStats extraction, tracking, mapping, total;
+  StageStats segmentation, extraction, tracking, mapping, total;
+  std::string segmenter;  // backend name, empty without segmentation
   std::vector<FrameReport> reports;
   double TrackedFraction() const { return frames ? static_cast<double>(tracked) / frames : 0.0; }
 };
@@ -43,7 +47,22 @@ using ProgressFn = std::function<void(size_t done, size_t total, const FrameRepo
 // Sequential mode: one frame at a time through extraction, tracking and local mapping.
 // Deterministic for a given dataset, settings and seed.
 RunSummary RunSequential(const RgbdDataset& dataset, const Settings& settings,
-                         const RunOptions& options, const ProgressFn& progress = nullptr);
+                         const RunOptions& options, const ProgressFn& progress = nullptr,
+                         Segmenter* segmenter = nullptr);
+
+// Threaded mode: a loader/segmentation thread feeds an extraction thread, which feeds the
+// tracking thread, through bounded queues (closing a queue ends the stream). Local mapping still
+// runs in the tracking thread, so the trajectory equals the sequential one; only wall-clock time
+// changes.
+RunSummary RunThreaded(const RgbdDataset& dataset, const Settings& settings,
+                       const RunOptions& options, const ProgressFn& progress = nullptr,
+                       Segmenter* segmenter = nullptr);
+
+// RunThreaded if options.threaded, else RunSequential.
+// With a segmenter, every frame is segmented and the Det-SLAM filter rejects keypoints on
+// dynamic objects (in threaded mode segmentation runs in its own thread).
+RunSummary Run(const RgbdDataset& dataset, const Settings& settings, const RunOptions& options,
+               const ProgressFn& progress = nullptr, Segmenter* segmenter = nullptr);
 
 StageStats ComputeStageStats(std::vector<double> values);
 

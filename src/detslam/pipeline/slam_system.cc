@@ -16,9 +16,9 @@ double MsSince(std::chrono::steady_clock::time_point t0) {
 }  // namespace
 
 bool SlamOptions::Check(std::string* error) const {
-  std::string e1, e2, e3;
-  const bool ok = orb.Check(&e1) & tracker.Check(&e2) & mapper.Check(&e3);
-  if (error) *error = e1 + e2 + e3;
+  std::string e1, e2, e3, e4;
+  const bool ok = orb.Check(&e1) & tracker.Check(&e2) & mapper.Check(&e3) & dynamic.Check(&e4);
+  if (error) *error = e1 + e2 + e3 + e4;
   return ok;
 }
 
@@ -45,42 +45,91 @@ SlamSystem::SlamSystem(const PinholeCamera& camera, const SlamOptions& options)
 FrameReport SlamSystem::ProcessFrame(int64_t index, Timestamp stamp, const cv::Mat& gray,
                                      const cv::Mat& depth_m, const cv::Mat& ignore_mask) {
   FrameReport report;
-  report.index = index;
-  report.stamp = stamp;
-  auto t0 = std::chrono::steady_clock::now();
+  Frame frame = ExtractFrame(index, stamp, gray, depth_m, ignore_mask, &report);
+  TrackFrame(std::move(frame), &report);
+  return report;
+}
+
+Frame SlamSystem::ExtractFrame(int64_t index, Timestamp stamp, const cv::Mat& gray,
+                               const cv::Mat& depth_m, const cv::Mat& ignore_mask,
+                               FrameReport* report, const std::vector<Instance>* instances) const {
+  const auto t0 = std::chrono::steady_clock::now();
   std::vector<cv::KeyPoint> keypoints;
   cv::Mat descriptors;
-  extractor_.Extract(gray, ignore_mask, &keypoints, &descriptors);
+  cv::Mat mask = ignore_mask;
+  if (instances != nullptr && options_.dynamic_premask && !instances->empty()) {
+    cv::Mat dyn = DynamicIgnoreMask(*instances, depth_m, gray.size(), options_.dynamic);
+    if (mask.empty()) {
+      mask = dyn;
+    } else {
+      cv::bitwise_or(mask, dyn, mask);
+    }
+  }
+  extractor_.Extract(gray, mask, &keypoints, &descriptors);
+  std::vector<cv::KeyPoint> rejected;
+  std::vector<KeypointLabel> rejected_labels;
+  if (instances != nullptr) {
+    std::vector<float> kp_depth(keypoints.size(), -1.0f);
+    for (size_t i = 0; i < keypoints.size() && !depth_m.empty(); ++i) {
+      const int u = static_cast<int>(std::lround(keypoints[i].pt.x));
+      const int v = static_cast<int>(std::lround(keypoints[i].pt.y));
+      if (u >= 0 && v >= 0 && u < depth_m.cols && v < depth_m.rows) kp_depth[i] = depth_m.at<float>(v, u);
+    }
+    std::vector<KeypointLabel> labels(keypoints.size(), KeypointLabel::kStatic);
+    const DynamicFilterStats stats = LabelDynamicKeypoints(keypoints, kp_depth, *instances, depth_m, options_.dynamic, &labels);
+    report->dynamic_instances = stats.instances_used;
+    std::vector<cv::KeyPoint> kept;
+    cv::Mat kept_desc;
+    for (size_t i = 0; i < keypoints.size(); ++i) {
+      if (labels[i] == KeypointLabel::kStatic) {
+        kept.push_back(keypoints[i]);
+        kept_desc.push_back(descriptors.row(static_cast<int>(i)));
+      } else {
+        rejected.push_back(keypoints[i]);
+        rejected_labels.push_back(labels[i]);
+      }
+    }
+    keypoints = std::move(kept);
+    descriptors = kept_desc;
+    report->rejected_keypoints = static_cast<int>(rejected.size());
+  }
   Frame frame;
   frame.index = index;
   frame.stamp = stamp;
-  frame.features = BuildFrameFeatures(camera_, std::move(keypoints), descriptors, depth_m);
-  report.num_keypoints = static_cast<int>(frame.size());
-  report.timings.extraction_ms = MsSince(t0);
+  auto features = BuildFrameFeatures(camera_, std::move(keypoints), descriptors, depth_m);
+  features->rejected_keypoints = std::move(rejected);
+  features->rejected_labels = std::move(rejected_labels);
+  frame.features = std::move(features);
+  report->index = index;
+  report->stamp = stamp;
+  report->num_keypoints = static_cast<int>(frame.size());
+  report->timings.extraction_ms = MsSince(t0);
+  return frame;
+}
 
-  t0 = std::chrono::steady_clock::now();
+void SlamSystem::TrackFrame(Frame frame, FrameReport* report) {
+  auto t0 = std::chrono::steady_clock::now();
   const size_t kfs_before = map_.NumKeyFrames();
-  report.tracking = tracker_.Track(&frame);
+  report->tracking = tracker_.Track(&frame);
   KeyFrameId new_kf = kNoKeyFrame;
-  if (report.tracking.pose_valid && report.tracking.need_keyframe) new_kf = tracker_.CreateKeyFrame(&frame);
+  if (report->tracking.pose_valid && report->tracking.need_keyframe) new_kf = tracker_.CreateKeyFrame(&frame);
   if (map_.NumKeyFrames() > kfs_before && new_kf == kNoKeyFrame) new_kf = tracker_.reference_keyframe();
-  report.timings.tracking_ms = MsSince(t0);
+  report->timings.tracking_ms = MsSince(t0);
 
-  if (report.tracking.pose_valid) {
+  if (report->tracking.pose_valid) {
     const KeyFrameId ref = frame.reference_keyframe != kNoKeyFrame ? frame.reference_keyframe : tracker_.reference_keyframe();
-    tracked_.push_back({stamp, ref, *frame.cam_from_world * map_.keyframe(ref).cam_from_world.Inverse()});
+    tracked_.push_back({frame.stamp, ref, *frame.cam_from_world * map_.keyframe(ref).cam_from_world.Inverse()});
   }
   if (new_kf != kNoKeyFrame) {
-    report.keyframe = true;
+    report->keyframe = true;
     t0 = std::chrono::steady_clock::now();
     const LocalMappingSummary s = mapper_.ProcessKeyFrame(new_kf);
     for (const ErasedKeyFrame& e : s.erased_keyframes) {
       erased_[e.id] = e;
       tracker_.OnKeyFrameErased(e.id);
     }
-    report.timings.mapping_ms = MsSince(t0);
+    report->timings.mapping_ms = MsSince(t0);
   }
-  return report;
 }
 
 Rigid3d SlamSystem::ReferenceWorldFromCam(KeyFrameId id, const Rigid3d& cam_from_ref) const {

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "detslam/dynamic/dynamic_filter.h"
 #include "detslam/features/orb_extractor.h"
 #include "detslam/io/trajectory.h"
 #include "detslam/map/map.h"
@@ -21,6 +22,8 @@ struct SlamOptions {
   OrbOptions orb;
   TrackerOptions tracker;
   LocalMapperOptions mapper;
+  DynamicFilterOptions dynamic;   // Det-SLAM filter (used when instances are passed in)
+  bool dynamic_premask = true;    // also drop dynamic corners before the ORB spatial distribution
   bool Check(std::string* error) const;
 };
 
@@ -31,6 +34,9 @@ struct FrameTimings {
 
 struct FrameReport {
   int64_t index = 0;
+  int dynamic_instances = 0;  // dynamic instances the filter used
+  int rejected_keypoints = 0; // keypoints rejected by the dynamic filter (after extraction)
+  double segmentation_ms = 0; // time of the segmenter for this frame
   Timestamp stamp;
   TrackingResult tracking;
   bool keyframe = false;
@@ -42,10 +48,20 @@ class SlamSystem {
  public:
   SlamSystem(const PinholeCamera& camera, const SlamOptions& options);
 
-  // Processes one RGB-D frame. gray: CV_8UC1; depth_m: CV_32FC1 metres (0 = missing);
-  // ignore_mask: empty or CV_8UC1, non-zero = no keypoints there.
+  // Processes one RGB-D frame: ExtractFrame then TrackFrame. gray: CV_8UC1; depth_m: CV_32FC1
+  // metres (0 = missing); ignore_mask: empty or CV_8UC1, non-zero = no keypoints there.
   FrameReport ProcessFrame(int64_t index, Timestamp stamp, const cv::Mat& gray,
                            const cv::Mat& depth_m, const cv::Mat& ignore_mask = cv::Mat());
+
+  // Feature extraction stage: thread-safe (const), may run ahead of tracking in another thread.
+  // With `instances` (from a segmenter), the Det-SLAM filter rejects keypoints on dynamic objects:
+  // they are moved to the frame's rejected list (labelled) and never reach tracking. Fills
+  // report->timings.extraction_ms, num_keypoints and the dynamic counters.
+  Frame ExtractFrame(int64_t index, Timestamp stamp, const cv::Mat& gray, const cv::Mat& depth_m,
+                     const cv::Mat& ignore_mask, FrameReport* report,
+                     const std::vector<Instance>* instances = nullptr) const;
+  // Tracking and (for keyframes) local mapping of an extracted frame, in input order.
+  void TrackFrame(Frame frame, FrameReport* report);
 
   // Every tracked frame's pose, recomputed from its reference keyframe's current pose.
   Trajectory FrameTrajectory() const;
