@@ -10,6 +10,7 @@
 #include "detslam/io/dataset.h"
 #include "detslam/io/settings.h"
 #include "detslam/pipeline/runner.h"
+#include "detslam/segmentation/segmenter_factory.h"
 #include "detslam/synth/writer.h"
 #include "support/shared_data.h"
 
@@ -31,14 +32,17 @@ struct SlamRun {
   std::string trajectory_path;
 };
 
-SlamRun RunAndEvaluate(const std::string& dataset_dir, const std::string& out_dir, uint64_t seed) {
+SlamRun RunAndEvaluate(const std::string& dataset_dir, const std::string& out_dir, uint64_t seed,
+                       bool threaded = false, const std::string& segmenter_spec = "none") {
   const RgbdDataset dataset = RgbdDataset::Open(dataset_dir, {});
   const Settings settings = PresetForDataset(dataset_dir);
   RunOptions options;
   options.out_dir = out_dir;
+  options.threaded = threaded;
   options.slam = SlamOptionsFromSettings(settings, seed);
+  const std::unique_ptr<Segmenter> segmenter = MakeSegmenter(segmenter_spec, dataset_dir, settings, "");
   SlamRun run;
-  run.summary = RunSequential(dataset, settings, options);
+  run.summary = Run(dataset, settings, options, nullptr, segmenter.get());
   run.trajectory_path = (fs::path(out_dir) / "trajectory.txt").string();
   run.eval = EvaluateFiles(dataset.groundtruth_path(), run.trajectory_path, dataset_dir, {});
   return run;
@@ -73,6 +77,41 @@ TEST(DataSlamFr2Desk, SeededSequentialRunsAreIdentical) {
   ASSERT_FALSE(ta.empty());
   // The header names the output folder; compare the pose lines.
   EXPECT_EQ(ta.substr(ta.find("\n1311")), tb.substr(tb.find("\n1311")));
+}
+
+TEST(DataSlamFr2Desk, ThreadedRunnerGivesTheSequentialTrajectory) {
+  DETSLAM_REQUIRE_SHARED("data/tum/rgbd_dataset_freiburg2_desk_subset50");
+  const std::string dir = testing::SharedPath("data/tum/rgbd_dataset_freiburg2_desk_subset50");
+  const SlamRun a = RunAndEvaluate(dir, TempDir("seq"), 5, false);
+  const SlamRun b = RunAndEvaluate(dir, TempDir("thr"), 5, true);
+  const std::string ta = ReadFile(a.trajectory_path), tb = ReadFile(b.trajectory_path);
+  EXPECT_EQ(ta.substr(ta.find("\n1311")), tb.substr(tb.find("\n1311")));
+  EXPECT_EQ(b.summary.frames, 50u);
+}
+
+// People walking through the view: without the dynamic filter the trajectory is far off; with
+// the ground-truth masks (oracle segmenter) it stays close to the accuracy of the static twin.
+TEST(IntegrationSlamDynamic, GroundTruthMasksRemoveThePeople) {
+  SynthOptions so;
+  so.preset = "walking_xyz";
+  so.seed = 2;
+  so.frames = 200;
+  const std::string seq = TempDir("walking");
+  WriteSequence(so, seq);
+  so.people = false;
+  const std::string twin = TempDir("walking_twin");
+  WriteSequence(so, twin);
+  const SlamRun with_gt = RunAndEvaluate(seq, TempDir("walking_gt"), 42, false, "gt");
+  const SlamRun without = RunAndEvaluate(seq, TempDir("walking_none"), 42, false, "none");
+  const SlamRun static_twin = RunAndEvaluate(twin, TempDir("walking_twin_run"), 42);
+  EXPECT_EQ(with_gt.summary.tracked, with_gt.summary.frames);
+  const double gt_rmse = with_gt.eval.ate.error_m.rmse, twin_rmse = static_twin.eval.ate.error_m.rmse;
+  const double none_rmse = without.eval.ate.error_m.rmse;
+  EXPECT_LE(gt_rmse, std::max(2.0 * twin_rmse, 0.01)) << "gt " << gt_rmse << " twin " << twin_rmse;
+  EXPECT_GE(none_rmse, 3.0 * gt_rmse) << "none " << none_rmse << " gt " << gt_rmse;
+  int frames_with_people = 0;
+  for (const FrameReport& r : with_gt.summary.reports) frames_with_people += r.dynamic_instances > 0 ? 1 : 0;
+  EXPECT_GT(frames_with_people, 100) << "the filter saw people in too few frames";
 }
 
 TEST(IntegrationSlamSynthetic, StaticPresetTracksEveryFrameWithinOneCentimetre) {
