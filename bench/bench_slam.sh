@@ -17,7 +17,7 @@ work="$(mktemp -d)"
 trap 'rm -rf "$work"' EXIT
 m() { python3 "$here/slam_metrics.py" "$@"; }
 mm() { python3 -c "print(f'{float($1)*1000:.1f}')"; }
-pct() { python3 -c "print(f'{float($1)*100:.1f}')"; }
+f1() { python3 -c "print(f'{float($1):.1f}')"; }
 
 row() {  # name dataset_dir run_dir eval_json -> one markdown row
   local name=$1 ds=$2 run=$3 ev=$4
@@ -25,9 +25,9 @@ row() {  # name dataset_dir run_dir eval_json -> one markdown row
     "$(mm "$(m field "$ev" ate.rmse)") | $(mm "$(m field "$ev" ate.median)") |" \
     "$(mm "$(m field "$ev" ate.max)") | $(mm "$(m field "$ev" rpe.trans_m_per_s.rmse)") |" \
     "$(python3 -c "print(f'{float($(m field "$ev" rpe.rot_deg_per_s.rmse)):.2f}')") |" \
-    "$(m field "$run/run.json" keyframes) | $(m field "$run/run.json" timings.extraction.median_ms) |" \
-    "$(m field "$run/run.json" timings.tracking.median_ms) |" \
-    "$(m field "$run/run.json" timings.local_mapping_per_keyframe.median_ms) |"
+    "$(m field "$run/run.json" keyframes) | $(f1 "$(m field "$run/run.json" timings.extraction.median_ms)") |" \
+    "$(f1 "$(m field "$run/run.json" timings.tracking.median_ms)") |" \
+    "$(f1 "$(m field "$run/run.json" timings.local_mapping_per_keyframe.median_ms)") |"
 }
 
 run_eval() {  # dataset_dir out_dir [seed]
