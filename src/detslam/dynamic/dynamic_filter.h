@@ -33,7 +33,8 @@ namespace detslam {
 struct DynamicFilterOptions {
   std::vector<std::string> dynamic_classes = {"person"};  // class names treated as dynamic
   float min_score = 0.0f;                                 // ignore instances below this score
-  int mask_dilation_px = 5;    // dilate each instance mask by this many pixels (ellipse)
+  int mask_dilation_px = 15;   // dilate masks by the ORB patch radius: descriptors of corners
+                               // closer than that to a person sample the person's pixels
   bool depth_step = true;      // the paper's depth-ROI step
   double alpha = 0.1;          // widening factor of the depth interval (paper's alpha)
   double depth_bin_m = 0.05;   // histogram bin for the dominant depth mode of the object

@@ -11,6 +11,13 @@
 namespace detslam {
 namespace {
 
+// The hand-made scene below is laid out for a 5 px mask dilation (the arm sits 8 px from the mask).
+DynamicFilterOptions SceneOptions() {
+  DynamicFilterOptions o;
+  o.mask_dilation_px = 5;
+  return o;
+}
+
 // A 160x120 depth image: a wall at 4 m; a person (x in [60, 90), y in [30, 110)) whose depth rises
 // from 1.9 m (left) to 2.1 m (right); an arm the mask misses (x in [90, 100), y in [50, 56)) at
 // 2.0 m; a chair outside the person's box at 2.0 m; a depth hole at (100, 70).
@@ -208,7 +215,7 @@ TEST(LabelDynamicKeypointsTest, PersonInFrontOfWall) {
       {130, 60},     // 8 chair at person depth outside the box
       {-3, 500},     // 9 outside the image
   };
-  const Labelled out = Label(points, {scene.Person()}, scene.depth, DynamicFilterOptions());
+  const Labelled out = Label(points, {scene.Person()}, scene.depth, SceneOptions());
   constexpr auto S = KeypointLabel::kStatic;
   constexpr auto M = KeypointLabel::kDynamicMask;
   constexpr auto D = KeypointLabel::kDynamicDepth;
@@ -217,12 +224,12 @@ TEST(LabelDynamicKeypointsTest, PersonInFrontOfWall) {
   EXPECT_EQ(out.stats.rejected_mask, 3);
   EXPECT_EQ(out.stats.rejected_depth, 1);
 
-  DynamicFilterOptions no_depth_step;
+  DynamicFilterOptions no_depth_step = SceneOptions();
   no_depth_step.depth_step = false;
   const Labelled mask_only = Label(points, {scene.Person()}, scene.depth, no_depth_step);
   EXPECT_EQ(mask_only.labels, (std::vector<KeypointLabel>{M, M, M, S, S, S, S, S, S, S}));
   const Labelled no_depth_image =
-      Label(points, {scene.Person()}, cv::Mat(), DynamicFilterOptions());
+      Label(points, {scene.Person()}, cv::Mat(), SceneOptions());
   EXPECT_EQ(no_depth_image.labels, mask_only.labels);
 }
 
@@ -232,11 +239,11 @@ TEST(LabelDynamicKeypointsTest, NonDynamicClassesAreIgnored) {
   chair.class_id = 56;
   chair.class_name = "chair";
   const std::vector<cv::Point2f> points = {{70, 60}, {97, 53}};
-  const Labelled ignored = Label(points, {chair}, scene.depth, DynamicFilterOptions());
+  const Labelled ignored = Label(points, {chair}, scene.depth, SceneOptions());
   EXPECT_EQ(ignored.labels, std::vector<KeypointLabel>(2, KeypointLabel::kStatic));
   EXPECT_EQ(ignored.stats.instances_used, 0);
 
-  DynamicFilterOptions with_chairs;
+  DynamicFilterOptions with_chairs = SceneOptions();
   with_chairs.dynamic_classes = {"person", "chair"};
   const Labelled used = Label(points, {chair}, scene.depth, with_chairs);
   EXPECT_EQ(used.labels, (std::vector<KeypointLabel>{KeypointLabel::kDynamicMask,
@@ -329,7 +336,7 @@ TEST(DynamicFilterOptionsTest, Check) {
 TEST(DynamicIgnoreMaskTest, PersonScenePixels) {
   const PersonScene scene;
   const cv::Mat ignore =
-      DynamicIgnoreMask({scene.Person()}, scene.depth, scene.depth.size(), DynamicFilterOptions());
+      DynamicIgnoreMask({scene.Person()}, scene.depth, scene.depth.size(), SceneOptions());
   ASSERT_EQ(ignore.type(), CV_8UC1);
   ASSERT_EQ(ignore.size(), scene.depth.size());
   EXPECT_NE(ignore.at<uint8_t>(53, 97), 0);    // arm

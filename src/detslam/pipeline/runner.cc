@@ -11,6 +11,7 @@
 #include <thread>
 
 #include "detslam/core/atomic_file.h"
+#include "detslam/dynamic/instance_memory.h"
 #include "detslam/io/ply.h"
 #include "detslam/pipeline/bounded_queue.h"
 
@@ -56,7 +57,7 @@ void WriteOutputs(const RgbdDataset& dataset, const Settings& settings, const Ru
   j["segmenter"] = summary.segmenter.empty() ? "none" : summary.segmenter;
   j["dynamic_filter"] = {{"classes", options.slam.dynamic.dynamic_classes}, {"alpha", options.slam.dynamic.alpha},
                          {"depth_step", options.slam.dynamic.depth_step}, {"mask_dilation_px", options.slam.dynamic.mask_dilation_px},
-                         {"premask", options.slam.dynamic_premask}};
+                         {"premask", options.slam.dynamic_premask}, {"memory_frames", options.slam.dynamic_memory_frames}};
   j["timings"] = {{"segmentation", StatsJson(summary.segmentation)}, {"extraction", StatsJson(summary.extraction)}, {"tracking", StatsJson(summary.tracking)},
                   {"local_mapping_per_keyframe", StatsJson(summary.mapping)}, {"total_per_frame", StatsJson(summary.total)}};
   nlohmann::json per_frame = nlohmann::json::array();
@@ -91,6 +92,7 @@ SlamOptions SlamOptionsFromSettings(const Settings& settings, uint64_t seed) {
   o.dynamic.mask_dilation_px = settings.GetInt("Dynamic.MaskDilation", o.dynamic.mask_dilation_px);
   o.dynamic.min_score = static_cast<float>(settings.GetDouble("Dynamic.MinScore", o.dynamic.min_score));
   o.dynamic_premask = settings.GetBool("Dynamic.PreMask", o.dynamic_premask);
+  o.dynamic_memory_frames = settings.GetInt("Dynamic.MemoryFrames", o.dynamic_memory_frames);
   const std::string classes = settings.GetString("Dynamic.Classes", "");
   if (!classes.empty()) {
     o.dynamic.dynamic_classes.clear();
@@ -181,7 +183,7 @@ struct LoadedFrame {
 };
 
 LoadedFrame LoadAndSegment(const RgbdDataset& dataset, const Settings& settings, size_t i,
-                           Segmenter* segmenter) {
+                           Segmenter* segmenter, InstanceMemory* memory) {
   LoadedFrame f;
   f.index = static_cast<int64_t>(i);
   f.images = dataset.Load(i, settings.camera);
@@ -192,7 +194,7 @@ LoadedFrame LoadAndSegment(const RgbdDataset& dataset, const Settings& settings,
     in.stamp = dataset.frame(i).rgb_stamp;
     in.bgr = f.images.bgr;
     in.depth_m = f.images.depth_m;
-    f.instances = segmenter->Segment(in);
+    f.instances = memory->Update(segmenter->Segment(in));
     f.segmented = true;
     f.segmentation_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   }
@@ -226,10 +228,11 @@ RunSummary RunSequential(const RgbdDataset& dataset, const Settings& settings,
                          Segmenter* segmenter) {
   const auto start = std::chrono::steady_clock::now();
   SlamSystem slam(settings.camera, options.slam);
+  InstanceMemory memory(options.slam.dynamic_memory_frames);
   const size_t n = FrameCount(dataset, options);
   RunRecorder recorder(n, progress);
   for (size_t i = 0; i < n; ++i) {
-    const LoadedFrame loaded = LoadAndSegment(dataset, settings, i, segmenter);
+    const LoadedFrame loaded = LoadAndSegment(dataset, settings, i, segmenter, &memory);
     FrameReport report;
     Frame frame = Extract(slam, dataset, loaded, &report);
     slam.TrackFrame(std::move(frame), &report);
@@ -243,6 +246,7 @@ RunSummary RunThreaded(const RgbdDataset& dataset, const Settings& settings,
                        Segmenter* segmenter) {
   const auto start = std::chrono::steady_clock::now();
   SlamSystem slam(settings.camera, options.slam);
+  InstanceMemory memory(options.slam.dynamic_memory_frames);
   const size_t n = FrameCount(dataset, options);
   RunRecorder recorder(n, progress);
   struct Extracted {
@@ -255,7 +259,7 @@ RunSummary RunThreaded(const RgbdDataset& dataset, const Settings& settings,
   std::thread loader = Producer(
       [&] {
         for (size_t i = 0; i < n; ++i) {
-          if (!loaded.Push(LoadAndSegment(dataset, settings, i, segmenter))) break;
+          if (!loaded.Push(LoadAndSegment(dataset, settings, i, segmenter, &memory))) break;
         }
       },
       &load_error, [&] { loaded.Close(); });

@@ -24,6 +24,7 @@ struct SlamOptions {
   LocalMapperOptions mapper;
   DynamicFilterOptions dynamic;   // Det-SLAM filter (used when instances are passed in)
   bool dynamic_premask = true;    // also drop dynamic corners before the ORB spatial distribution
+  int dynamic_memory_frames = 3;  // carry lost dynamic instances forward this many frames (0.1 s)
   bool Check(std::string* error) const;
 };
 
