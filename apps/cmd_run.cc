@@ -26,6 +26,7 @@ struct RunArgs {
   double max_dt = 0.02;
   bool no_progress = false;
   bool threaded = false;
+  bool inline_mapping = false;
   std::string segmenter;  // empty: dnn if the models are found, else none
   std::string models;
   double alpha = -1;
@@ -67,6 +68,7 @@ void Run(const RunArgs& a) {
   options.max_frames = a.max_frames;
   options.threaded = a.threaded;
   options.slam = SlamOptionsFromSettings(settings, a.seed);
+  options.slam.mapping_thread = a.threaded && !a.inline_mapping;
   if (a.alpha >= 0) options.slam.dynamic.alpha = a.alpha;
   if (a.no_depth_step) options.slam.dynamic.depth_step = false;
   std::string error;
@@ -120,7 +122,10 @@ void AddRunCommand(CLI::App& app) {
   cmd->add_option("--models", args->models, "Models folder for --segmenter dnn (default $DETSLAM_MODELS or ../shared/models)");
   cmd->add_option("--alpha", args->alpha, "Det-SLAM depth-step widening factor alpha (default from settings Dynamic.Alpha, else 0.1)");
   cmd->add_flag("--no-depth-step", args->no_depth_step, "Mask step only (no depth-ROI step)");
-  cmd->add_flag("--threaded", args->threaded, "Load and extract features in a second thread (same trajectory, faster)");
+  cmd->add_flag("--threaded", args->threaded,
+                "One thread per stage: loading+segmentation, extraction, tracking, local mapping (real-time use; not bit-reproducible)");
+  cmd->add_flag("--inline-mapping", args->inline_mapping,
+                "With --threaded: local mapping in the tracking thread (then the trajectory equals the sequential one)");
   cmd->add_flag("--no-progress", args->no_progress, "No progress bar");
   cmd->callback([args] { Run(*args); });
 }

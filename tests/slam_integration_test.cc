@@ -33,13 +33,15 @@ struct SlamRun {
 };
 
 SlamRun RunAndEvaluate(const std::string& dataset_dir, const std::string& out_dir, uint64_t seed,
-                       bool threaded = false, const std::string& segmenter_spec = "none") {
+                       bool threaded = false, const std::string& segmenter_spec = "none",
+                       bool mapping_thread = false) {
   const RgbdDataset dataset = RgbdDataset::Open(dataset_dir, {});
   const Settings settings = PresetForDataset(dataset_dir);
   RunOptions options;
   options.out_dir = out_dir;
   options.threaded = threaded;
   options.slam = SlamOptionsFromSettings(settings, seed);
+  options.slam.mapping_thread = mapping_thread;
   const std::unique_ptr<Segmenter> segmenter = MakeSegmenter(segmenter_spec, dataset_dir, settings, "");
   SlamRun run;
   run.summary = Run(dataset, settings, options, nullptr, segmenter.get());
@@ -87,6 +89,16 @@ TEST(DataSlamFr2Desk, ThreadedRunnerGivesTheSequentialTrajectory) {
   const std::string ta = ReadFile(a.trajectory_path), tb = ReadFile(b.trajectory_path);
   EXPECT_EQ(ta.substr(ta.find("\n1311")), tb.substr(tb.find("\n1311")));
   EXPECT_EQ(b.summary.frames, 50u);
+}
+
+// Local mapping in its own thread: results depend on timing, so only accuracy is asserted.
+TEST(DataSlamFr2Desk, MappingThreadTracksEveryFrameAccurately) {
+  DETSLAM_REQUIRE_SHARED("data/tum/rgbd_dataset_freiburg2_desk_subset50");
+  const std::string dir = testing::SharedPath("data/tum/rgbd_dataset_freiburg2_desk_subset50");
+  const SlamRun run = RunAndEvaluate(dir, TempDir("mapping_thread"), 5, true, "none", true);
+  EXPECT_EQ(run.summary.tracked, 50u);
+  EXPECT_LE(run.eval.ate.error_m.rmse, 0.01) << "ATE RMSE " << run.eval.ate.error_m.rmse;
+  EXPECT_GE(run.summary.keyframes, 2u);
 }
 
 // People walking through the view: without the dynamic filter the trajectory is far off; with

@@ -29,7 +29,9 @@ LocalMapper::LocalMapper(const PinholeCamera& camera, LocalMapperOptions options
   DETSLAM_CHECK_MSG(options_.Check(&error), error);
 }
 
-LocalMappingSummary LocalMapper::ProcessKeyFrame(KeyFrameId current) {
+LocalMappingSummary LocalMapper::ProcessKeyFrame(KeyFrameId current, std::mutex* map_mutex) {
+  std::unique_lock<std::mutex> lock;
+  if (map_mutex != nullptr) lock = std::unique_lock<std::mutex>(*map_mutex);
   LocalMappingSummary summary;
   KeyFrame& kf = map_->keyframe(current);
   for (LandmarkId lm : kf.landmarks) {
@@ -45,7 +47,7 @@ LocalMappingSummary LocalMapper::ProcessKeyFrame(KeyFrameId current) {
   map_->UpdateConnections(current);
   CullLandmarks(current, &summary);
   if (options_.fuse) FuseWithNeighbours(current, &summary);
-  if (options_.local_ba && map_->NumKeyFrames() > 2) LocalBundleAdjustment(current, &summary);
+  if (options_.local_ba && map_->NumKeyFrames() > 2) LocalBundleAdjustment(current, &summary, &lock);
   if (options_.cull_keyframes) CullKeyFrames(current, &summary);
   return summary;
 }
@@ -131,7 +133,8 @@ void LocalMapper::FuseWithNeighbours(KeyFrameId current, LocalMappingSummary* su
   map_->UpdateConnections(current);
 }
 
-void LocalMapper::LocalBundleAdjustment(KeyFrameId current, LocalMappingSummary* summary) {
+void LocalMapper::LocalBundleAdjustment(KeyFrameId current, LocalMappingSummary* summary,
+                                        std::unique_lock<std::mutex>* lock) {
   const auto t0 = std::chrono::steady_clock::now();
   std::vector<KeyFrameId> local = {current};
   for (KeyFrameId k : map_->BestCovisibles(current, static_cast<size_t>(options_.max_local_keyframes - 1))) local.push_back(k);
@@ -187,7 +190,9 @@ void LocalMapper::LocalBundleAdjustment(KeyFrameId current, LocalMappingSummary*
   }
   BundleOptions bo;
   bo.max_iterations = options_.ba_iterations;
+  if (lock->owns_lock()) lock->unlock();  // solve on the copy while tracking goes on
   const BundleSummary s = SolveBundle(camera_, &problem, bo);
+  if (lock->mutex() != nullptr) lock->lock();
   if (!s.usable) return;
   for (size_t k = 0; k < problem.observations.size(); ++k) {
     if (s.outlier[k] && map_->HasLandmark(obs_ref[k].first)) {
@@ -196,7 +201,7 @@ void LocalMapper::LocalBundleAdjustment(KeyFrameId current, LocalMappingSummary*
     }
   }
   for (const auto& p : problem.poses) {
-    if (!p.fixed) map_->keyframe(p.id).cam_from_world = p.cam_from_world;
+    if (!p.fixed && map_->HasKeyFrame(p.id)) map_->keyframe(p.id).cam_from_world = p.cam_from_world;
   }
   for (const auto& p : problem.points) {
     if (!map_->HasLandmark(p.id)) continue;

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <deque>
+#include <mutex>
 #include <string>
 #include <utility>
 #include <vector>
@@ -45,13 +46,16 @@ class LocalMapper {
  public:
   LocalMapper(const PinholeCamera& camera, LocalMapperOptions options, Map* map);
 
-  // Processes a keyframe just inserted by the tracker. Deterministic.
-  LocalMappingSummary ProcessKeyFrame(KeyFrameId kf);
+  // Processes a keyframe just inserted by the tracker. Deterministic. With `map_mutex`, the map
+  // is locked for every step except the bundle-adjustment solve, which runs on a copy of the
+  // problem while the tracker may use the map (the result is applied under the lock).
+  LocalMappingSummary ProcessKeyFrame(KeyFrameId kf, std::mutex* map_mutex = nullptr);
 
  private:
   void CullLandmarks(KeyFrameId current, LocalMappingSummary* summary);
   void FuseWithNeighbours(KeyFrameId current, LocalMappingSummary* summary);
-  void LocalBundleAdjustment(KeyFrameId current, LocalMappingSummary* summary);
+  void LocalBundleAdjustment(KeyFrameId current, LocalMappingSummary* summary,
+                             std::unique_lock<std::mutex>* lock);
   void CullKeyFrames(KeyFrameId current, LocalMappingSummary* summary);
 
   PinholeCamera camera_;

@@ -39,7 +39,7 @@ void WriteOutputs(const RgbdDataset& dataset, const Settings& settings, const Ru
   nlohmann::json j;
   j["dataset"] = dataset.dir();
   j["settings"] = settings.source;
-  j["mode"] = options.threaded ? "threaded" : "sequential";
+  j["mode"] = options.threaded ? (options.slam.mapping_thread ? "threaded (mapping thread)" : "threaded") : "sequential";
   j["camera"] = {{"fx", settings.camera.fx}, {"fy", settings.camera.fy}, {"cx", settings.camera.cx},
                  {"cy", settings.camera.cy}, {"depth_map_factor", settings.camera.depth_map_factor},
                  {"bf", settings.camera.bf}, {"th_depth", settings.camera.th_depth}};
@@ -135,22 +135,22 @@ class RunRecorder {
     if (r.segmentation_ms > 0) seg_.push_back(r.segmentation_ms);
     ext_.push_back(r.timings.extraction_ms);
     trk_.push_back(r.timings.tracking_ms);
-    if (r.keyframe) map_.push_back(r.timings.mapping_ms);
     total_ms_.push_back(r.segmentation_ms + r.timings.extraction_ms + r.timings.tracking_ms + r.timings.mapping_ms);
     summary_.reports.push_back(r);
     if (progress_) progress_(summary_.frames, total_, r);
   }
 
   RunSummary Finish(const RgbdDataset& dataset, const Settings& settings, const RunOptions& options,
-                    const SlamSystem& slam, std::chrono::steady_clock::time_point start,
+                    SlamSystem& slam, std::chrono::steady_clock::time_point start,
                     const Segmenter* segmenter) {
+    slam.Finish();  // drain the mapping thread before reading the map
     if (segmenter != nullptr) summary_.segmenter = segmenter->name();
     summary_.segmentation = ComputeStageStats(seg_);
     summary_.keyframes = slam.map().NumKeyFrames();
     summary_.landmarks = slam.map().NumLandmarks();
     summary_.extraction = ComputeStageStats(ext_);
     summary_.tracking = ComputeStageStats(trk_);
-    summary_.mapping = ComputeStageStats(map_);
+    summary_.mapping = ComputeStageStats(slam.mapping_times_ms());
     summary_.total = ComputeStageStats(total_ms_);
     summary_.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     WriteOutputs(dataset, settings, options, slam, summary_);
@@ -161,7 +161,7 @@ class RunRecorder {
   size_t total_;
   ProgressFn progress_;
   RunSummary summary_;
-  std::vector<double> seg_, ext_, trk_, map_, total_ms_;
+  std::vector<double> seg_, ext_, trk_, total_ms_;
 };
 
 size_t FrameCount(const RgbdDataset& dataset, const RunOptions& options) {

@@ -51,9 +51,10 @@ RunSummary RunSequential(const RgbdDataset& dataset, const Settings& settings,
                          Segmenter* segmenter = nullptr);
 
 // Threaded mode: a loader/segmentation thread feeds an extraction thread, which feeds the
-// tracking thread, through bounded queues (closing a queue ends the stream). Local mapping still
-// runs in the tracking thread, so the trajectory equals the sequential one; only wall-clock time
-// changes.
+// tracking thread, through bounded queues (closing a queue ends the stream). With
+// options.slam.mapping_thread, local mapping runs in a fourth thread (results then depend on
+// timing); without it, mapping runs in the tracking thread and the trajectory equals the
+// sequential one.
 RunSummary RunThreaded(const RgbdDataset& dataset, const Settings& settings,
                        const RunOptions& options, const ProgressFn& progress = nullptr,
                        Segmenter* segmenter = nullptr);

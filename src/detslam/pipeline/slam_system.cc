@@ -40,6 +40,38 @@ SlamSystem::SlamSystem(const PinholeCamera& camera, const SlamOptions& options)
       mapper_(camera, options.mapper, &map_) {
   std::string error;
   DETSLAM_CHECK_MSG(camera_.Check(&error), error);
+  if (options_.mapping_thread) {
+    keyframe_queue_ = std::make_unique<BoundedQueue<KeyFrameId>>(8);
+    mapping_thread_ = std::thread([this] { MappingLoop(); });
+  }
+}
+
+SlamSystem::~SlamSystem() { Finish(); }
+
+void SlamSystem::Finish() {
+  if (!mapping_thread_.joinable()) return;
+  keyframe_queue_->Close();
+  mapping_thread_.join();
+}
+
+void SlamSystem::MappingLoop() {
+  while (std::optional<KeyFrameId> kf = keyframe_queue_->Pop()) {
+    FrameReport unused;
+    MapKeyFrame(*kf, &unused);
+  }
+}
+
+void SlamSystem::MapKeyFrame(KeyFrameId kf, FrameReport* report) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const LocalMappingSummary s = mapper_.ProcessKeyFrame(kf, options_.mapping_thread ? &map_mutex_ : nullptr);
+  std::unique_lock<std::mutex> lock;
+  if (options_.mapping_thread) lock = std::unique_lock<std::mutex>(map_mutex_);
+  for (const ErasedKeyFrame& e : s.erased_keyframes) {
+    erased_[e.id] = e;
+    tracker_.OnKeyFrameErased(e.id);
+  }
+  report->timings.mapping_ms = MsSince(t0);
+  mapping_times_ms_.push_back(report->timings.mapping_ms);
 }
 
 FrameReport SlamSystem::ProcessFrame(int64_t index, Timestamp stamp, const cv::Mat& gray,
@@ -109,6 +141,8 @@ Frame SlamSystem::ExtractFrame(int64_t index, Timestamp stamp, const cv::Mat& gr
 
 void SlamSystem::TrackFrame(Frame frame, FrameReport* report) {
   auto t0 = std::chrono::steady_clock::now();
+  std::unique_lock<std::mutex> lock;
+  if (options_.mapping_thread) lock = std::unique_lock<std::mutex>(map_mutex_);
   const size_t kfs_before = map_.NumKeyFrames();
   report->tracking = tracker_.Track(&frame);
   KeyFrameId new_kf = kNoKeyFrame;
@@ -122,13 +156,12 @@ void SlamSystem::TrackFrame(Frame frame, FrameReport* report) {
   }
   if (new_kf != kNoKeyFrame) {
     report->keyframe = true;
-    t0 = std::chrono::steady_clock::now();
-    const LocalMappingSummary s = mapper_.ProcessKeyFrame(new_kf);
-    for (const ErasedKeyFrame& e : s.erased_keyframes) {
-      erased_[e.id] = e;
-      tracker_.OnKeyFrameErased(e.id);
+    if (options_.mapping_thread) {
+      lock.unlock();
+      keyframe_queue_->Push(new_kf);
+    } else {
+      MapKeyFrame(new_kf, report);
     }
-    report->timings.mapping_ms = MsSince(t0);
   }
 }
 

@@ -5,6 +5,8 @@
 
 #include <map>
 #include <memory>
+#include <mutex>
+#include <thread>
 #include <opencv2/core.hpp>
 #include <string>
 #include <vector>
@@ -14,6 +16,7 @@
 #include "detslam/io/trajectory.h"
 #include "detslam/map/map.h"
 #include "detslam/mapping/local_mapper.h"
+#include "detslam/pipeline/bounded_queue.h"
 #include "detslam/tracking/tracker.h"
 
 namespace detslam {
@@ -24,6 +27,7 @@ struct SlamOptions {
   LocalMapperOptions mapper;
   DynamicFilterOptions dynamic;   // Det-SLAM filter (used when instances are passed in)
   bool dynamic_premask = true;    // also drop dynamic corners before the ORB spatial distribution
+  bool mapping_thread = false;    // local mapping in its own thread (not deterministic)
   int dynamic_memory_frames = 3;  // carry lost dynamic instances forward this many frames (0.1 s)
   bool Check(std::string* error) const;
 };
@@ -48,6 +52,13 @@ struct FrameReport {
 class SlamSystem {
  public:
   SlamSystem(const PinholeCamera& camera, const SlamOptions& options);
+  ~SlamSystem();
+  SlamSystem(const SlamSystem&) = delete;
+  SlamSystem& operator=(const SlamSystem&) = delete;
+
+  // Waits until the mapping thread (if any) has processed every queued keyframe and stops it.
+  // Call before reading the trajectory or the map; ProcessFrame/TrackFrame must not follow.
+  void Finish();
 
   // Processes one RGB-D frame: ExtractFrame then TrackFrame. gray: CV_8UC1; depth_m: CV_32FC1
   // metres (0 = missing); ignore_mask: empty or CV_8UC1, non-zero = no keypoints there.
@@ -69,9 +80,13 @@ class SlamSystem {
   // Keyframe poses (world_from_cam) in id order.
   Trajectory KeyFrameTrajectory() const;
   const Map& map() const { return map_; }
+  // Local-mapping time of every processed keyframe (ms), in processing order.
+  const std::vector<double>& mapping_times_ms() const { return mapping_times_ms_; }
 
  private:
   Rigid3d ReferenceWorldFromCam(KeyFrameId id, const Rigid3d& cam_from_ref) const;
+  void MapKeyFrame(KeyFrameId kf, FrameReport* report);
+  void MappingLoop();
 
   PinholeCamera camera_;
   SlamOptions options_;
@@ -86,6 +101,12 @@ class SlamSystem {
   };
   std::vector<TrackedFrame> tracked_;
   std::map<KeyFrameId, ErasedKeyFrame> erased_;
+  std::vector<double> mapping_times_ms_;
+  // Mapping thread: the map store's one lock guards map_, tracker_ state and erased_ while both
+  // threads run; the queue hands keyframes from tracking to mapping.
+  std::mutex map_mutex_;
+  std::unique_ptr<BoundedQueue<KeyFrameId>> keyframe_queue_;
+  std::thread mapping_thread_;
 };
 
 ScaleInfo MakeScaleInfo(const OrbExtractor& extractor);
