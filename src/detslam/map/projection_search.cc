@@ -19,6 +19,28 @@ ProjectionCandidate CandidateFromLandmark(const Landmark& lm) {
   return c;
 }
 
+std::vector<LandmarkId> MatchKeyFrameLandmarks(const KeyFrame& keyframe, const FrameFeatures& frame,
+                                               double ratio, int max_distance) {
+  std::vector<cv::KeyPoint> kps;
+  std::vector<LandmarkId> ids;
+  cv::Mat desc;
+  for (size_t i = 0; i < keyframe.size(); ++i) {
+    if (keyframe.landmarks[i] == kNoLandmark) continue;
+    kps.push_back(keyframe.features->keypoints[i]);
+    ids.push_back(keyframe.landmarks[i]);
+    desc.push_back(keyframe.features->descriptors.row(static_cast<int>(i)));
+  }
+  std::vector<LandmarkId> out(frame.size(), kNoLandmark);
+  if (kps.empty() || frame.size() == 0) return out;
+  MatchOptions mo;
+  mo.ratio = ratio;
+  mo.max_distance = max_distance;
+  for (const cv::DMatch& m : MatchBruteForce(kps, desc, frame.keypoints, frame.descriptors, mo)) {
+    out[static_cast<size_t>(m.trainIdx)] = ids[static_cast<size_t>(m.queryIdx)];
+  }
+  return out;
+}
+
 std::vector<bool> TakenMask(const Frame& frame) {
   std::vector<bool> taken(frame.size(), false);
   for (size_t i = 0; i < frame.size(); ++i) taken[i] = frame.landmarks[i] != kNoLandmark;

@@ -36,6 +36,11 @@ ProjectionCandidate CandidateFromLandmark(const Landmark& landmark);
 // True for keypoints of `frame` already associated with a landmark.
 std::vector<bool> TakenMask(const Frame& frame);
 
+// Brute-force descriptor matching of a keyframe's landmark-bearing keypoints against a frame:
+// returns, per frame keypoint, the matched landmark (kNoLandmark where none).
+std::vector<LandmarkId> MatchKeyFrameLandmarks(const KeyFrame& keyframe, const FrameFeatures& frame,
+                                               double ratio, int max_distance);
+
 // For each candidate, the index of the matched keypoint in `features` (or -1). Keypoints listed in
 // `taken` (same size as features; true = already associated) are skipped. Deterministic.
 std::vector<int> SearchByProjection(const PinholeCamera& camera, const ScaleInfo& scale,

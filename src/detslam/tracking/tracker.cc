@@ -215,26 +215,10 @@ bool Tracker::TrackWithMotionModel(Frame* frame) {
 bool Tracker::TrackReferenceKeyFrame(Frame* frame) {
   if (!map_->HasKeyFrame(reference_kf_)) return false;
   const KeyFrame& ref = map_->keyframe(reference_kf_);
-  std::vector<cv::KeyPoint> ref_kps;
-  std::vector<LandmarkId> ref_ids;
-  cv::Mat ref_desc;
-  for (size_t i = 0; i < ref.size(); ++i) {
-    if (ref.landmarks[i] == kNoLandmark) continue;
-    ref_kps.push_back(ref.features->keypoints[i]);
-    ref_ids.push_back(ref.landmarks[i]);
-    ref_desc.push_back(ref.features->descriptors.row(static_cast<int>(i)));
-  }
-  if (ref_kps.empty()) return false;
-  MatchOptions mo;
-  mo.ratio = 0.7;
-  mo.max_distance = kThLow;
-  const std::vector<cv::DMatch> matches =
-      MatchBruteForce(ref_kps, ref_desc, frame->features->keypoints, frame->features->descriptors, mo);
-  if (matches.size() < 15) return false;
-  frame->landmarks.assign(frame->size(), kNoLandmark);
-  for (const cv::DMatch& m : matches) {
-    frame->landmarks[static_cast<size_t>(m.trainIdx)] = ref_ids[static_cast<size_t>(m.queryIdx)];
-  }
+  frame->landmarks = MatchKeyFrameLandmarks(ref, *frame->features, 0.7, kThLow);
+  const auto matched = std::count_if(frame->landmarks.begin(), frame->landmarks.end(),
+                                     [](LandmarkId id) { return id != kNoLandmark; });
+  if (matched < 15) return false;
   frame->cam_from_world = last_frame_ ? *last_frame_->cam_from_world : ref.cam_from_world;
   return OptimizeFramePose(frame, false) >= options_.min_pose_inliers;
 }

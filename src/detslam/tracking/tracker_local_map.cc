@@ -102,37 +102,26 @@ bool Tracker::Relocalize(Frame* frame) {
   const FrameFeatures& f = *frame->features;
   std::vector<KeyFrameId> kfs;
   for (auto it = map_->keyframes().rbegin(); it != map_->keyframes().rend(); ++it) kfs.push_back(it->first);
-  MatchOptions mo;
-  mo.ratio = 0.75;
-  mo.max_distance = kThLow;
   for (KeyFrameId kf_id : kfs) {
-    const KeyFrame& kf = map_->keyframe(kf_id);
-    std::vector<cv::KeyPoint> kps;
-    std::vector<LandmarkId> ids;
-    cv::Mat desc;
-    for (size_t i = 0; i < kf.size(); ++i) {
-      if (kf.landmarks[i] == kNoLandmark) continue;
-      kps.push_back(kf.features->keypoints[i]);
-      ids.push_back(kf.landmarks[i]);
-      desc.push_back(kf.features->descriptors.row(static_cast<int>(i)));
-    }
-    if (kps.size() < 15) continue;
-    const std::vector<cv::DMatch> matches = MatchBruteForce(kps, desc, f.keypoints, f.descriptors, mo);
-    if (matches.size() < 15) continue;
+    const std::vector<LandmarkId> matched = MatchKeyFrameLandmarks(map_->keyframe(kf_id), f, 0.75, kThLow);
+    std::vector<size_t> kp_index;
     std::vector<Eigen::Vector3d> pts;
     std::vector<Eigen::Vector2d> px;
     std::vector<double> sigma2;
-    for (const cv::DMatch& m : matches) {
-      pts.push_back(map_->landmark(ids[static_cast<size_t>(m.queryIdx)]).position);
-      px.push_back(f.undist[static_cast<size_t>(m.trainIdx)]);
-      sigma2.push_back(map_->scale().level_sigma2[static_cast<size_t>(f.keypoints[static_cast<size_t>(m.trainIdx)].octave)]);
+    for (size_t i = 0; i < matched.size(); ++i) {
+      if (matched[i] == kNoLandmark) continue;
+      kp_index.push_back(i);
+      pts.push_back(map_->landmark(matched[i]).position);
+      px.push_back(f.undist[i]);
+      sigma2.push_back(map_->scale().level_sigma2[static_cast<size_t>(f.keypoints[i].octave)]);
     }
+    if (kp_index.size() < 15) continue;
     RansacOptions ro;
     const PnpResult pnp = SolvePnpRansac(camera_, pts, px, sigma2, ro, rng_);
     if (!pnp.success) continue;
     frame->landmarks.assign(frame->size(), kNoLandmark);
-    for (size_t k = 0; k < matches.size(); ++k) {
-      if (pnp.inliers[k]) frame->landmarks[static_cast<size_t>(matches[k].trainIdx)] = ids[static_cast<size_t>(matches[k].queryIdx)];
+    for (size_t k = 0; k < kp_index.size(); ++k) {
+      if (pnp.inliers[k]) frame->landmarks[kp_index[k]] = matched[kp_index[k]];
     }
     frame->cam_from_world = pnp.cam_from_world;
     temp_matched_.assign(frame->size(), false);
