@@ -93,9 +93,9 @@ void Run(const RunArgs& a) {
   const RunSummary s = Run(dataset, settings, options, [&](size_t d, size_t t, const FrameReport& r) { bar.Update(d, t, r); }, segmenter.get());
   std::printf("tracked %zu/%zu frames (%.1f%%), %zu keyframes, %zu map points, %zu relocalisations\n",
               s.tracked, s.frames, 100.0 * s.TrackedFraction(), s.keyframes, s.landmarks, s.relocalizations);
-  if (!s.segmenter.empty()) std::printf("segmentation (%s): median %.1f ms per frame\n", s.segmenter.c_str(), s.segmentation.median_ms);
+  if (!s.segmenter.empty()) std::printf("segmentation (%s): median %.1f ms per frame\n", s.segmenter.c_str(), s.segmentation.median);
   std::printf("median ms per frame: extraction %.1f, tracking %.1f, total %.1f; local mapping %.1f per keyframe\n",
-              s.extraction.median_ms, s.tracking.median_ms, s.total.median_ms, s.mapping.median_ms);
+              s.extraction.median, s.tracking.median, s.total.median, s.mapping.median);
   const fs::path out(a.out);
   std::printf("outputs: %s %s %s %s\n", (out / "trajectory.txt").c_str(), (out / "keyframes.txt").c_str(),
               (out / "map.ply").c_str(), (out / "run.json").c_str());

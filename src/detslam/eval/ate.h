@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "detslam/core/association.h"
-#include "detslam/eval/stats.h"
+#include "detslam/core/stats.h"
 #include "detslam/geometry/alignment.h"
 #include "detslam/io/trajectory.h"
 

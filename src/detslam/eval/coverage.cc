@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <utility>
 
-#include "detslam/eval/stats.h"
+#include "detslam/core/stats.h"
 
 namespace detslam {
 

@@ -21,7 +21,7 @@
 #include <string>
 #include <vector>
 
-#include "detslam/eval/stats.h"
+#include "detslam/core/stats.h"
 #include "detslam/io/trajectory.h"
 
 namespace detslam {

@@ -18,8 +18,9 @@
 namespace detslam {
 namespace {
 
-nlohmann::json StatsJson(const StageStats& s) {
-  return {{"median_ms", s.median_ms}, {"mean_ms", s.mean_ms}, {"p90_ms", s.p90_ms}, {"max_ms", s.max_ms}};
+nlohmann::json StatsJson(const ErrorStats& s) {
+  return {{"count", s.count}, {"median_ms", s.median}, {"mean_ms", s.mean}, {"std_ms", s.std},
+          {"min_ms", s.min}, {"max_ms", s.max}};
 }
 
 void WriteOutputs(const RgbdDataset& dataset, const Settings& settings, const RunOptions& options,
@@ -109,18 +110,6 @@ SlamOptions SlamOptionsFromSettings(const Settings& settings, uint64_t seed) {
   return o;
 }
 
-StageStats ComputeStageStats(std::vector<double> v) {
-  StageStats s;
-  if (v.empty()) return s;
-  std::sort(v.begin(), v.end());
-  const size_t n = v.size();
-  s.median_ms = n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-  s.mean_ms = std::accumulate(v.begin(), v.end(), 0.0) / static_cast<double>(n);
-  s.p90_ms = v[std::min(n - 1, static_cast<size_t>(0.9 * static_cast<double>(n)))];
-  s.max_ms = v.back();
-  return s;
-}
-
 namespace {
 
 // Collects per-frame reports and turns them into the summary and the output files.
@@ -145,13 +134,13 @@ class RunRecorder {
                     const Segmenter* segmenter) {
     slam.Finish();  // drain the mapping thread before reading the map
     if (segmenter != nullptr) summary_.segmenter = segmenter->name();
-    summary_.segmentation = ComputeStageStats(seg_);
+    summary_.segmentation = ComputeErrorStats(seg_);
     summary_.keyframes = slam.map().NumKeyFrames();
     summary_.landmarks = slam.map().NumLandmarks();
-    summary_.extraction = ComputeStageStats(ext_);
-    summary_.tracking = ComputeStageStats(trk_);
-    summary_.mapping = ComputeStageStats(slam.mapping_times_ms());
-    summary_.total = ComputeStageStats(total_ms_);
+    summary_.extraction = ComputeErrorStats(ext_);
+    summary_.tracking = ComputeErrorStats(trk_);
+    summary_.mapping = ComputeErrorStats(slam.mapping_times_ms());
+    summary_.total = ComputeErrorStats(total_ms_);
     summary_.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     WriteOutputs(dataset, settings, options, slam, summary_);
     return summary_;

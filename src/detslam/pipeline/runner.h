@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "detslam/core/stats.h"
 #include "detslam/io/dataset.h"
 #include "detslam/io/settings.h"
 #include "detslam/pipeline/slam_system.h"
@@ -25,9 +26,6 @@ struct RunOptions {
 // SlamOptions from settings (ORBextractor.* and any detslam keys), with `seed` for RANSAC.
 SlamOptions SlamOptionsFromSettings(const Settings& settings, uint64_t seed);
 
-struct StageStats {
-  double median_ms = 0, mean_ms = 0, p90_ms = 0, max_ms = 0;
-};
 
 struct RunSummary {
   size_t frames = 0;
@@ -36,7 +34,7 @@ struct RunSummary {
   size_t landmarks = 0;
   size_t relocalizations = 0;
   double wall_s = 0;
-  StageStats segmentation, extraction, tracking, mapping, total;
+  ErrorStats segmentation, extraction, tracking, mapping, total;  // per-stage times, ms
   std::string segmenter;  // backend name, empty without segmentation
   std::vector<FrameReport> reports;
   double TrackedFraction() const { return frames ? static_cast<double>(tracked) / frames : 0.0; }
@@ -65,6 +63,5 @@ RunSummary RunThreaded(const RgbdDataset& dataset, const Settings& settings,
 RunSummary Run(const RgbdDataset& dataset, const Settings& settings, const RunOptions& options,
                const ProgressFn& progress = nullptr, Segmenter* segmenter = nullptr);
 
-StageStats ComputeStageStats(std::vector<double> values);
 
 }  // namespace detslam

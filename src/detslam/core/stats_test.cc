@@ -1,4 +1,4 @@
-#include "detslam/eval/stats.h"
+#include "detslam/core/stats.h"
 
 #include <gtest/gtest.h>
 
