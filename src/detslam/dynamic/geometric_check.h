@@ -18,7 +18,7 @@ namespace detslam {
 
 struct GeometricCheckOptions {
   double k = 3.0;              // threshold in robust standard deviations above the median
-  double min_threshold = 2.0;  // floor on the threshold, in the residuals' unit (e.g. pixels)
+  double min_threshold = 4.0;  // floor on the threshold, in the residuals' unit (e.g. pixels)
   int min_samples = 10;        // fewer static residuals than this: flag nothing
 
   bool Check(std::string* error) const;

@@ -56,6 +56,9 @@ struct Frame {
   std::shared_ptr<const FrameFeatures> features;  // shared with the keyframe made from it
   std::vector<LandmarkId> landmarks;  // per keypoint, kNoLandmark if none
   std::vector<bool> outlier;          // per keypoint, set by pose optimisation
+  // Per keypoint, set by tracking: kGeometric where the geometric check found a mover the
+  // segmenter missed (never used for new landmarks or frame-to-frame points); else kStatic.
+  std::vector<KeypointLabel> labels;
   std::optional<Rigid3d> cam_from_world;
   KeyFrameId reference_keyframe = kNoKeyFrame;
 

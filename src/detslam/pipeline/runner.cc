@@ -12,6 +12,7 @@
 
 #include "detslam/core/atomic_file.h"
 #include "detslam/dynamic/instance_memory.h"
+#include "detslam/dynamic/mask_propagation.h"
 #include "detslam/io/ply.h"
 #include "detslam/pipeline/bounded_queue.h"
 
@@ -58,7 +59,8 @@ void WriteOutputs(const RgbdDataset& dataset, const Settings& settings, const Ru
   j["segmenter"] = summary.segmenter.empty() ? "none" : summary.segmenter;
   j["dynamic_filter"] = {{"classes", options.slam.dynamic.dynamic_classes}, {"alpha", options.slam.dynamic.alpha},
                          {"depth_step", options.slam.dynamic.depth_step}, {"mask_dilation_px", options.slam.dynamic.mask_dilation_px},
-                         {"premask", options.slam.dynamic_premask}, {"memory_frames", options.slam.dynamic_memory_frames}};
+                         {"premask", options.slam.dynamic_premask}, {"memory_frames", options.slam.dynamic_memory_frames},
+                         {"geometric_check", options.slam.tracker.geometric_check}, {"segment_every", options.segment_every}};
   j["timings"] = {{"segmentation", StatsJson(summary.segmentation)}, {"extraction", StatsJson(summary.extraction)}, {"tracking", StatsJson(summary.tracking)},
                   {"local_mapping_per_keyframe", StatsJson(summary.mapping)}, {"total_per_frame", StatsJson(summary.total)}};
   nlohmann::json per_frame = nlohmann::json::array();
@@ -67,7 +69,8 @@ void WriteOutputs(const RgbdDataset& dataset, const Settings& settings, const Ru
                          {"tracked", r.tracking.pose_valid}, {"method", r.tracking.method},
                          {"inliers", r.tracking.num_inliers}, {"keyframe", r.keyframe},
                          {"keypoints", r.num_keypoints}, {"dynamic_instances", r.dynamic_instances},
-                         {"rejected_keypoints", r.rejected_keypoints}, {"segmentation_ms", r.segmentation_ms},
+                         {"rejected_keypoints", r.rejected_keypoints}, {"geometric_rejected", r.tracking.geometric_rejected},
+                         {"segmentation_ms", r.segmentation_ms},
                          {"extraction_ms", r.timings.extraction_ms},
                          {"tracking_ms", r.timings.tracking_ms}, {"mapping_ms", r.timings.mapping_ms}});
   }
@@ -86,6 +89,7 @@ SlamOptions SlamOptionsFromSettings(const Settings& settings, uint64_t seed) {
   o.orb.min_th_fast = settings.orb.min_th_fast;
   o.tracker.seed = seed;
   o.tracker.max_frames_between_keyframes = std::max(1, static_cast<int>(std::lround(settings.camera.fps)));
+  o.tracker.keyframe_far_points = settings.GetInt("Tracking.KeyFrameFarPoints", o.tracker.keyframe_far_points);
   o.mapper.local_ba = settings.GetBool("LocalMapping.BundleAdjustment", o.mapper.local_ba);
   o.mapper.max_local_keyframes = settings.GetInt("LocalMapping.MaxLocalKeyFrames", o.mapper.max_local_keyframes);
   o.dynamic.alpha = settings.GetDouble("Dynamic.Alpha", o.dynamic.alpha);
@@ -94,6 +98,9 @@ SlamOptions SlamOptionsFromSettings(const Settings& settings, uint64_t seed) {
   o.dynamic.min_score = static_cast<float>(settings.GetDouble("Dynamic.MinScore", o.dynamic.min_score));
   o.dynamic_premask = settings.GetBool("Dynamic.PreMask", o.dynamic_premask);
   o.dynamic_memory_frames = settings.GetInt("Dynamic.MemoryFrames", o.dynamic_memory_frames);
+  o.tracker.geometric_check = settings.GetBool("Dynamic.GeometricCheck", o.tracker.geometric_check);
+  o.tracker.geometric.k = settings.GetDouble("Dynamic.GeometricK", o.tracker.geometric.k);
+  o.tracker.geometric.min_threshold = settings.GetDouble("Dynamic.GeometricMinResidual", o.tracker.geometric.min_threshold);
   const std::string classes = settings.GetString("Dynamic.Classes", "");
   if (!classes.empty()) {
     o.dynamic.dynamic_classes.clear();
@@ -171,19 +178,34 @@ struct LoadedFrame {
   double segmentation_ms = 0;
 };
 
+// The dynamic-object state carried across frames by the loading stage.
+struct SegmentationState {
+  explicit SegmentationState(const RunOptions& options)
+      : memory(options.slam.dynamic_memory_frames), every(std::max(1, options.segment_every)) {}
+  InstanceMemory memory;       // detections lost for a frame or two
+  MaskPropagator propagator;   // masks between segmented frames (segment_every > 1)
+  int every;
+};
+
 LoadedFrame LoadAndSegment(const RgbdDataset& dataset, const Settings& settings, size_t i,
-                           Segmenter* segmenter, InstanceMemory* memory) {
+                           Segmenter* segmenter, SegmentationState* state) {
   LoadedFrame f;
   f.index = static_cast<int64_t>(i);
   f.images = dataset.Load(i, settings.camera);
-  if (segmenter != nullptr) {
+  if (segmenter != nullptr && state->every > 1 && i % static_cast<size_t>(state->every) != 0) {
+    const auto t0 = std::chrono::steady_clock::now();
+    f.instances = state->propagator.Propagate(f.images.gray);
+    f.segmented = true;
+    f.segmentation_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  } else if (segmenter != nullptr) {
     const auto t0 = std::chrono::steady_clock::now();
     SegmenterInput in;
     in.index = f.index;
     in.stamp = dataset.frame(i).rgb_stamp;
     in.bgr = f.images.bgr;
     in.depth_m = f.images.depth_m;
-    f.instances = memory->Update(segmenter->Segment(in));
+    f.instances = state->memory.Update(segmenter->Segment(in));
+    if (state->every > 1) state->propagator.Reset(f.images.gray, f.instances);
     f.segmented = true;
     f.segmentation_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   }
@@ -217,11 +239,11 @@ RunSummary RunSequential(const RgbdDataset& dataset, const Settings& settings,
                          Segmenter* segmenter) {
   const auto start = std::chrono::steady_clock::now();
   SlamSystem slam(settings.camera, options.slam);
-  InstanceMemory memory(options.slam.dynamic_memory_frames);
+  SegmentationState seg_state(options);
   const size_t n = FrameCount(dataset, options);
   RunRecorder recorder(n, progress);
   for (size_t i = 0; i < n; ++i) {
-    const LoadedFrame loaded = LoadAndSegment(dataset, settings, i, segmenter, &memory);
+    const LoadedFrame loaded = LoadAndSegment(dataset, settings, i, segmenter, &seg_state);
     FrameReport report;
     Frame frame = Extract(slam, dataset, loaded, &report);
     slam.TrackFrame(std::move(frame), &report);
@@ -235,7 +257,7 @@ RunSummary RunThreaded(const RgbdDataset& dataset, const Settings& settings,
                        Segmenter* segmenter) {
   const auto start = std::chrono::steady_clock::now();
   SlamSystem slam(settings.camera, options.slam);
-  InstanceMemory memory(options.slam.dynamic_memory_frames);
+  SegmentationState seg_state(options);
   const size_t n = FrameCount(dataset, options);
   RunRecorder recorder(n, progress);
   struct Extracted {
@@ -248,7 +270,7 @@ RunSummary RunThreaded(const RgbdDataset& dataset, const Settings& settings,
   std::thread loader = Producer(
       [&] {
         for (size_t i = 0; i < n; ++i) {
-          if (!loaded.Push(LoadAndSegment(dataset, settings, i, segmenter, &memory))) break;
+          if (!loaded.Push(LoadAndSegment(dataset, settings, i, segmenter, &seg_state))) break;
         }
       },
       &load_error, [&] { loaded.Close(); });

@@ -20,6 +20,7 @@ struct RunOptions {
   int64_t max_frames = -1;      // stop after this many frames (< 0: all)
   bool threaded = false;        // loading + extraction in a second thread (same results)
   size_t queue_capacity = 4;    // frames buffered between the threaded stages
+  int segment_every = 1;        // run the segmenter on every k-th frame; masks carried in between
   SlamOptions slam;
 };
 

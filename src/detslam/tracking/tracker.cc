@@ -52,8 +52,11 @@ TrackingResult Tracker::Track(Frame* frame) {
   TrackingResult result;
   frame->landmarks.assign(frame->size(), kNoLandmark);
   frame->outlier.assign(frame->size(), false);
+  frame->labels.assign(frame->size(), KeypointLabel::kStatic);
   temp_matched_.assign(frame->size(), false);
   temp_match_position_.assign(frame->size(), Eigen::Vector3d::Zero());
+  dropped_.assign(frame->size(), false);
+  dropped_position_.assign(frame->size(), Eigen::Vector3d::Zero());
 
   if (state_ == TrackingState::kNotInitialized) {
     if (Initialize(frame)) {
@@ -96,6 +99,7 @@ TrackingResult Tracker::Track(Frame* frame) {
     }
   }
 
+  if (ok && options_.geometric_check) result.geometric_rejected = ApplyGeometricCheck(frame, &inliers);
   if (ok) {
     state_ = TrackingState::kOk;
     result.pose_valid = true;
@@ -148,6 +152,7 @@ void Tracker::BuildTemporaryPoints() {
   const Rigid3d world_from_cam = last_frame_->cam_from_world->Inverse();
   int created = 0;
   for (const auto& [d, i] : by_depth) {
+    if (!last_frame_->labels.empty() && last_frame_->labels[i] != KeypointLabel::kStatic) continue;
     const bool has_landmark = last_frame_->landmarks[i] != kNoLandmark && map_->HasLandmark(last_frame_->landmarks[i]);
     if (!has_landmark) {
       temporary_points_[i] = world_from_cam * camera_.Unproject(f.undist[i], d);
@@ -254,6 +259,8 @@ int Tracker::OptimizeFramePose(Frame* frame, bool include_temporary) {
     if (r.inliers[k]) {
       ++inliers;
     } else {
+      dropped_[i] = true;
+      dropped_position_[i] = obs[k].point_world;
       frame->landmarks[i] = kNoLandmark;
       temp_matched_[i] = false;
       frame->outlier[i] = true;

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "detslam/core/rng.h"
+#include "detslam/dynamic/geometric_check.h"
 #include "detslam/map/map.h"
 #include "detslam/optim/pose_optimizer.h"
 
@@ -27,12 +28,20 @@ struct TrackerOptions {
   int min_local_map_inliers = 30;      // TrackLocalMap success (50 right after relocalisation)
   int max_local_keyframes = 80;        // local map size
   int temporary_points_min = 100;      // frame-to-frame points from the last frame's depth
+  int keyframe_far_points = 300;       // landmarks from depth per keyframe beyond ThDepth (see docs)
   double recently_lost_seconds = 3.0;  // then LOST
   int max_frames_between_keyframes = 30;  // mMaxFrames (= fps)
   double ref_ratio = 0.75;             // thRefRatio (0.4 with one keyframe)
   int close_tracked_max = 100;         // bNeedToInsertClose: tracked close < this
   int close_untracked_min = 70;        //                      and untracked close > this
   uint64_t seed = 42;                  // relocalisation RANSAC
+  // Geometric check for movers the segmenter missed (see tracker_geometric.cc).
+  bool geometric_check = false;
+  GeometricCheckOptions geometric;     // robust threshold on reprojection residuals (pixels / scale)
+  double geometric_radius_px = 30.0;   // cluster / spread radius around a flagged keypoint
+  double geometric_depth_ratio = 0.1;  // same object: depths within this fraction
+  int geometric_min_cluster = 3;       // flagged neighbours needed to confirm a mover
+  double geometric_carry_window = 15.0;  // search window for last frame's movers (pixels, level 0)
   bool Check(std::string* error) const;
 };
 
@@ -42,6 +51,7 @@ struct TrackingResult {
   bool need_keyframe = false;
   bool relocalized = false;
   int num_inliers = 0;           // landmark inliers after local-map tracking
+  int geometric_rejected = 0;    // keypoints the geometric check labelled kGeometric
   std::string method;            // "init", "motion", "reference", "relocalization", "lost"
 };
 
@@ -74,6 +84,12 @@ class Tracker {
   // drops their associations. Returns the number of inliers.
   int OptimizeFramePose(Frame* frame, bool include_temporary);
   void BuildTemporaryPoints();
+  // Labels movers the segmenter missed as kGeometric (after the final pose is known): matched
+  // keypoints whose residual is far above the static ones' and confirmed by flagged neighbours,
+  // unmatched keypoints next to them at the same depth, and keypoints matching the last frame's
+  // movers. Drops their landmark associations and re-optimises the pose if any was an inlier.
+  // Returns the number of labelled keypoints.
+  int ApplyGeometricCheck(Frame* frame, int* inliers);
   void UpdateLocalMap(const Frame& frame);
   KeyFrameId CreateLandmarksFromDepth(Frame* frame, KeyFrameId kf_id);
 
@@ -96,6 +112,10 @@ class Tracker {
   std::vector<LandmarkId> local_landmarks_;
   std::vector<bool> temp_matched_;  // per current keypoint: matched to a temporary point
   std::vector<Eigen::Vector3d> temp_match_position_;
+  // Per current keypoint: the point of an association the pose optimiser rejected (for the
+  // geometric check's residuals).
+  std::vector<bool> dropped_;
+  std::vector<Eigen::Vector3d> dropped_position_;
 };
 
 }  // namespace detslam

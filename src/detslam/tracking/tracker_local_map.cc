@@ -166,6 +166,7 @@ bool Tracker::NeedNewKeyFrame(const Frame& frame, int inliers) const {
   int tracked_close = 0, untracked_close = 0;
   const FrameFeatures& f = *frame.features;
   for (size_t i = 0; i < f.size(); ++i) {
+    if (!frame.labels.empty() && frame.labels[i] != KeypointLabel::kStatic) continue;
     if (f.depth[i] > 0 && f.depth[i] < camera_.CloseDepthThreshold()) {
       if (frame.landmarks[i] != kNoLandmark) {
         ++tracked_close;
@@ -212,7 +213,8 @@ KeyFrameId Tracker::CreateLandmarksFromDepth(Frame* frame, KeyFrameId kf_id) {
   const FrameFeatures& f = *frame->features;
   std::vector<std::pair<float, size_t>> by_depth;
   for (size_t i = 0; i < f.size(); ++i) {
-    if (f.depth[i] > 0 && f.labels[i] == KeypointLabel::kStatic) by_depth.emplace_back(f.depth[i], i);
+    const bool mover = !frame->labels.empty() && frame->labels[i] != KeypointLabel::kStatic;
+    if (f.depth[i] > 0 && f.labels[i] == KeypointLabel::kStatic && !mover) by_depth.emplace_back(f.depth[i], i);
   }
   std::sort(by_depth.begin(), by_depth.end());
   const Rigid3d world_from_cam = frame->cam_from_world->Inverse();
@@ -226,7 +228,7 @@ KeyFrameId Tracker::CreateLandmarksFromDepth(Frame* frame, KeyFrameId kf_id) {
       frame->landmarks[i] = lm;
       ++created;
     }
-    if (d > camera_.CloseDepthThreshold() && created > options_.temporary_points_min) break;
+    if (d > camera_.CloseDepthThreshold() && created > options_.keyframe_far_points) break;
   }
   return kf_id;
 }

@@ -1,0 +1,102 @@
+#include "detslam/dynamic/mask_propagation.h"
+
+#include <algorithm>
+#include <opencv2/imgproc.hpp>
+#include <opencv2/video/tracking.hpp>
+#include <sstream>
+
+#include "detslam/core/check.h"
+
+namespace detslam {
+namespace {
+
+double MedianOf(std::vector<float> v) {
+  const size_t mid = v.size() / 2;
+  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(mid), v.end());
+  return v[mid];
+}
+
+cv::Mat Grow(const cv::Mat& mask, int px) {
+  if (mask.empty() || px <= 0) return mask;
+  cv::Mat out;
+  cv::dilate(mask, out, cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * px + 1, 2 * px + 1)));
+  return out;
+}
+
+}  // namespace
+
+bool MaskPropagationOptions::Check(std::string* error) const {
+  std::ostringstream os;
+  if (max_corners < 1) os << "max_corners must be >= 1; ";
+  if (grow_px_per_frame < 0) os << "grow_px_per_frame must be >= 0; ";
+  if (min_tracked < 1) os << "min_tracked must be >= 1; ";
+  if (error) *error = os.str();
+  return os.str().empty();
+}
+
+MaskPropagator::MaskPropagator(MaskPropagationOptions options) : options_(options) {
+  std::string error;
+  DETSLAM_CHECK_MSG(options_.Check(&error), "invalid MaskPropagationOptions: " << error);
+}
+
+cv::Mat ShiftMask(const cv::Mat& mask, double dx, double dy) {
+  if (mask.empty()) return mask;
+  const cv::Mat m = (cv::Mat_<double>(2, 3) << 1, 0, dx, 0, 1, dy);
+  cv::Mat out;
+  cv::warpAffine(mask, out, m, mask.size(), cv::INTER_NEAREST, cv::BORDER_CONSTANT, 0);
+  return out;
+}
+
+void MaskPropagator::Reset(const cv::Mat& gray, std::vector<Instance> instances) {
+  DETSLAM_CHECK(gray.type() == CV_8UC1);
+  last_gray_ = gray.clone();
+  instances_ = std::move(instances);
+  age_ = 0;
+}
+
+std::vector<Instance> MaskPropagator::Propagate(const cv::Mat& gray) {
+  DETSLAM_CHECK(gray.type() == CV_8UC1);
+  if (last_gray_.empty()) return {};
+  DETSLAM_CHECK_MSG(gray.size() == last_gray_.size(), "image size changed during the sequence");
+  ++age_;
+  const cv::Rect image(0, 0, gray.cols, gray.rows);
+  for (Instance& inst : instances_) {
+    cv::Mat region = inst.mask;
+    if (region.empty()) {
+      region = cv::Mat::zeros(gray.size(), CV_8UC1);
+      region(inst.box & image).setTo(255);
+    }
+    std::vector<cv::Point2f> from, to;
+    cv::goodFeaturesToTrack(last_gray_, from, options_.max_corners, 0.01, 5, region);
+    double dx = 0, dy = 0;
+    if (!from.empty()) {
+      std::vector<uchar> status;
+      std::vector<float> err;
+      cv::calcOpticalFlowPyrLK(last_gray_, gray, from, to, status, err, cv::Size(21, 21), 3);
+      std::vector<float> fx, fy;
+      for (size_t i = 0; i < from.size(); ++i) {
+        if (!status[i]) continue;
+        fx.push_back(to[i].x - from[i].x);
+        fy.push_back(to[i].y - from[i].y);
+      }
+      if (static_cast<int>(fx.size()) >= options_.min_tracked) {
+        dx = MedianOf(fx);
+        dy = MedianOf(fy);
+      }
+    }
+    inst.mask = ShiftMask(inst.mask, dx, dy);
+    inst.box = cv::Rect(cvRound(inst.box.x + dx), cvRound(inst.box.y + dy), inst.box.width, inst.box.height) & image;
+  }
+  instances_.erase(std::remove_if(instances_.begin(), instances_.end(), [](const Instance& i) { return i.box.empty(); }),
+                   instances_.end());  // moved out of view
+  last_gray_ = gray.clone();
+  std::vector<Instance> out = instances_;
+  const int grow = options_.grow_px_per_frame * age_;
+  for (Instance& inst : out) {
+    inst.mask = Grow(inst.mask, grow);
+    inst.box = cv::Rect(inst.box.x - grow, inst.box.y - grow, inst.box.width + 2 * grow, inst.box.height + 2 * grow) & image;
+  }
+  return out;
+}
+
+}  // namespace detslam

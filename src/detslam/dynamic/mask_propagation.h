@@ -1,0 +1,46 @@
+// Carries instance masks from a segmented frame to the following frames without running the
+// segmenter ("segment every k-th frame"): each instance's mask and box move with the median
+// optical flow (pyramidal Lucas-Kanade) of corners tracked inside the mask from the previous
+// frame, and the mask grows by a few pixels per frame of age to cover what the median flow misses
+// (limbs, the parts of a person turning). Frames must be fed in order.
+#pragma once
+
+#include <opencv2/core.hpp>
+#include <string>
+#include <vector>
+
+#include "detslam/segmentation/segmenter.h"
+
+namespace detslam {
+
+struct MaskPropagationOptions {
+  int max_corners = 80;        // corners tracked per instance
+  int grow_px_per_frame = 2;   // mask dilation added per frame since the last segmentation
+  int min_tracked = 3;         // fewer tracked corners: the instance keeps its place (still grown)
+  bool Check(std::string* error) const;
+};
+
+class MaskPropagator {
+ public:
+  explicit MaskPropagator(MaskPropagationOptions options = {});
+
+  // A segmented frame: its grey image (CV_8UC1) and instances become the new reference.
+  void Reset(const cv::Mat& gray, std::vector<Instance> instances);
+  // A frame without segmentation: the last frame's instances moved into `gray`. Empty before the
+  // first Reset.
+  std::vector<Instance> Propagate(const cv::Mat& gray);
+
+  // Frames since the last Reset (0 right after it).
+  int age() const { return age_; }
+
+ private:
+  MaskPropagationOptions options_;
+  cv::Mat last_gray_;
+  std::vector<Instance> instances_;  // in last_gray_, not yet grown
+  int age_ = 0;
+};
+
+// Shifts a CV_8UC1 mask by (dx, dy) pixels (zeros enter at the borders).
+cv::Mat ShiftMask(const cv::Mat& mask, double dx, double dy);
+
+}  // namespace detslam

@@ -1,0 +1,89 @@
+#include "detslam/dynamic/mask_propagation.h"
+
+#include <gtest/gtest.h>
+
+#include <opencv2/imgproc.hpp>
+
+#include "detslam/core/check.h"
+
+namespace detslam {
+namespace {
+
+// A textured square (the "person") at `corner` over a differently textured background.
+cv::Mat Scene(cv::Point corner) {
+  cv::Mat img(240, 320, CV_8UC1);
+  cv::RNG bg(1), fg(2);
+  bg.fill(img, cv::RNG::UNIFORM, 0, 100);
+  cv::GaussianBlur(img, img, cv::Size(3, 3), 0);
+  cv::Mat patch(60, 60, CV_8UC1);
+  fg.fill(patch, cv::RNG::UNIFORM, 100, 255);
+  cv::GaussianBlur(patch, patch, cv::Size(3, 3), 0);
+  patch.copyTo(img(cv::Rect(corner, patch.size())));
+  return img;
+}
+
+Instance Square(cv::Point corner) {
+  Instance inst;
+  inst.class_name = "person";
+  inst.box = cv::Rect(corner, cv::Size(60, 60));
+  inst.mask = cv::Mat::zeros(240, 320, CV_8UC1);
+  inst.mask(inst.box).setTo(255);
+  return inst;
+}
+
+cv::Point2d Centroid(const cv::Mat& mask) {
+  const cv::Moments m = cv::moments(mask, true);
+  return {m.m10 / m.m00, m.m01 / m.m00};
+}
+
+TEST(MaskPropagation, EmptyBeforeTheFirstSegmentedFrame) {
+  MaskPropagator p;
+  EXPECT_TRUE(p.Propagate(Scene({50, 50})).empty());
+}
+
+TEST(MaskPropagation, MasksFollowTheMovingObjectAndGrowWithAge) {
+  MaskPropagationOptions o;
+  o.grow_px_per_frame = 2;
+  MaskPropagator p(o);
+  p.Reset(Scene({100, 80}), {Square({100, 80})});
+  std::vector<Instance> out = p.Propagate(Scene({106, 83}));
+  ASSERT_EQ(out.size(), 1u);
+  EXPECT_EQ(p.age(), 1);
+  cv::Point2d c = Centroid(out[0].mask);
+  EXPECT_NEAR(c.x, 136, 1.0);
+  EXPECT_NEAR(c.y, 113, 1.0);
+  // Grown by 2 px on each side: a 64 x 64 footprint (rounded corners of the ellipse kernel).
+  EXPECT_NEAR(cv::countNonZero(out[0].mask), 64 * 64, 40);
+  EXPECT_EQ(out[0].box, cv::Rect(104, 81, 64, 64));
+  // Second frame: follows again, from the previous (propagated) frame, grown by 4 px.
+  out = p.Propagate(Scene({112, 86}));
+  ASSERT_EQ(out.size(), 1u);
+  c = Centroid(out[0].mask);
+  EXPECT_NEAR(c.x, 142, 1.0);
+  EXPECT_NEAR(c.y, 116, 1.0);
+  EXPECT_EQ(out[0].box, cv::Rect(108, 82, 68, 68));
+  // A new segmentation resets the age.
+  p.Reset(Scene({112, 86}), {Square({112, 86})});
+  EXPECT_EQ(p.age(), 0);
+}
+
+TEST(MaskPropagation, ShiftMaskMovesPixelsAndClearsTheBorder) {
+  cv::Mat m = cv::Mat::zeros(10, 10, CV_8UC1);
+  m.at<uint8_t>(2, 3) = 255;
+  const cv::Mat s = ShiftMask(m, 2, 1);
+  EXPECT_EQ(s.at<uint8_t>(3, 5), 255);
+  EXPECT_EQ(cv::countNonZero(s), 1);
+  EXPECT_EQ(cv::countNonZero(ShiftMask(m, 20, 0)), 0);
+}
+
+TEST(MaskPropagation, RejectsInvalidOptions) {
+  MaskPropagationOptions o;
+  o.max_corners = 0;
+  std::string error;
+  EXPECT_FALSE(o.Check(&error));
+  EXPECT_NE(error.find("max_corners"), std::string::npos);
+  EXPECT_DEATH(MaskPropagator{o}, "");
+}
+
+}  // namespace
+}  // namespace detslam
