@@ -40,11 +40,32 @@ def commit() -> str:
         status = subprocess.run(["git", "status", "--porcelain", "--untracked-files=no"],
                                 capture_output=True, text=True, check=True,
                                 cwd=os.path.dirname(os.path.abspath(__file__))).stdout
-        # The benchmark file itself does not make the measured code dirty.
-        dirty = [l for l in status.splitlines() if l.strip() and not l.endswith("docs/BENCHMARKS.md")]
+        # The benchmark file and the README summary do not make the measured code dirty.
+        dirty = [l for l in status.splitlines()
+                 if l.strip() and not l.endswith(("docs/BENCHMARKS.md", "README.md"))]
         return out.stdout.strip() + (" (uncommitted changes)" if dirty else "")
     except (OSError, subprocess.CalledProcessError):
         return "unknown"
+
+
+def replace_marked_block(text: str, name: str, content: str) -> str:
+    """`text` with the block between <!-- BEGIN name --> and <!-- END name --> replaced by
+    `content` (appended at the end when the markers are missing)."""
+    begin, end = f"<!-- BEGIN {name} -->", f"<!-- END {name} -->"
+    block = f"{begin}\n{content}{end}"
+    pattern = re.compile(re.escape(begin) + r".*?" + re.escape(end), re.S)
+    if pattern.search(text):
+        return pattern.sub(lambda _: block, text)
+    return text.rstrip() + "\n\n" + block + "\n"
+
+
+def write_atomically(path: str, text: str) -> None:
+    """Writes `text` to a temporary file beside `path`, then renames it over `path`."""
+    os.makedirs(os.path.dirname(path), exist_ok=True)
+    tmp = path + ".tmp"
+    with open(tmp, "w") as f:
+        f.write(text)
+    os.replace(tmp, path)
 
 
 def main() -> int:
@@ -68,18 +89,7 @@ def main() -> int:
     load = " ".join(f"{x:.2f}" for x in os.getloadavg())
     stamp = (f"_Written by `{command}` on {datetime.datetime.now().strftime('%Y-%m-%d %H:%M')}; "
              f"machine: {machine()}; load average when written {load}; commit {commit()}._\n\n")
-    begin, end = f"<!-- BEGIN {name} -->", f"<!-- END {name} -->"
-    block = f"{begin}\n{stamp}{body}{end}"
-    pattern = re.compile(re.escape(begin) + r".*?" + re.escape(end), re.S)
-    if pattern.search(text):
-        text = pattern.sub(lambda _: block, text)
-    else:
-        text = text.rstrip() + "\n\n" + block + "\n"
-    tmp = path + ".tmp"
-    os.makedirs(os.path.dirname(path), exist_ok=True)
-    with open(tmp, "w") as f:
-        f.write(text)
-    os.replace(tmp, path)
+    write_atomically(path, replace_marked_block(text, name, f"{stamp}{body}"))
     print(f"updated section '{name}' of {path}", file=sys.stderr)
     return 0
 

@@ -1,0 +1,117 @@
+#!/usr/bin/env python3
+"""Writes the README's benchmark summary table from the measured tables in docs/BENCHMARKS.md.
+
+The numbers come only from the sections the benchmark commands wrote (slam, dynamic); this script
+condenses them (per preset: seeds, frames tracked, ATE ratio to the static twin) and names the
+sections and their dates. The benchmark commands call it at the end; it can also be run alone.
+Usage: bench/readme_summary.py
+"""
+import os
+import re
+import statistics
+import sys
+
+from update_section import replace_marked_block, write_atomically
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+
+
+def section(text, name):
+    m = re.search(rf"<!-- BEGIN {name} -->\n(.*?)<!-- END {name} -->", text, re.S)
+    return m.group(1) if m else None
+
+
+def stamp_date(body):
+    m = re.search(r"on (\d{4}-\d{2}-\d{2} \d{2}:\d{2}); .*?commit ([0-9a-f]+[^._]*)", body)
+    return f"{m.group(1)}, commit {m.group(2).strip()}" if m else "unknown date"
+
+
+def tables(body):
+    """Every markdown table of a section as a list of dicts keyed by the header cells."""
+    out, lines = [], body.splitlines()
+    i = 0
+    while i < len(lines):
+        if lines[i].startswith("|") and i + 1 < len(lines) and lines[i + 1].startswith("|---"):
+            head = [c.strip() for c in lines[i].strip("|").split("|")]
+            rows, i = [], i + 2
+            while i < len(lines) and lines[i].startswith("|"):
+                rows.append(dict(zip(head, (c.strip() for c in lines[i].strip("|").split("|")))))
+                i += 1
+            out.append(rows)
+        else:
+            i += 1
+    return out
+
+
+def number(cell):
+    m = re.match(r"[-0-9.]+", cell)
+    return float(m.group(0)) if m else float("nan")
+
+
+def summary(bench_text):
+    rows = []
+    slam = section(bench_text, "slam")
+    if slam:
+        for table in tables(slam):
+            for r in table:
+                seq = r.get("sequence", "")
+                if seq.startswith("fr2/desk"):
+                    rows.append(("SLAM core, real TUM fr2/desk (50 frames)", f"{r['tracked']} tracked",
+                                 f"ATE RMSE {r['ATE RMSE mm']} mm (ORB-SLAM3: 7.0-8.1 mm)"))
+        static = [r for t in tables(slam) for r in t if r.get("sequence", "").startswith("static")]
+        if static:
+            ates = [number(r["ATE RMSE mm"]) for r in static]
+            tracked = "all frames tracked" if all(r["tracked"].split("/")[0] == r["tracked"].split("/")[1] for r in static) else "NOT all tracked"
+            rows.append((f"SLAM core, synthetic static ({len(static)} seeds)", tracked,
+                         f"ATE RMSE {min(ates):.1f}-{max(ates):.1f} mm"))
+        m = re.search(r"End drift: ([0-9.]+ cm over a [0-9.]+ m path \([0-9.]+ %\))", slam)
+        if m:
+            rows.append(("SLAM core, synthetic loop (no loop closing yet)", "", f"end drift {m.group(1)}"))
+    dyn = section(bench_text, "dynamic")
+    if dyn:
+        main = next((t for t in tables(dyn) if t and "ratio" in t[0]), [])
+        by_preset = {}
+        for r in main:
+            by_preset.setdefault(r["preset"], []).append(r)
+        for preset, rs in by_preset.items():
+            ratios = [number(r["ratio"]) for r in rs]
+            all_tracked = all(r["with filter (dnn)"].split("(")[1].rstrip(")").split("/")[0] ==
+                              r["with filter (dnn)"].split("(")[1].rstrip(")").split("/")[1] for r in rs)
+            met = sum(1 for r in rs if r["target met"] == "yes")
+            none = [number(r["without filter"]) for r in rs]
+            rows.append((f"Det-SLAM filter (dnn), {preset}",
+                         f"{'all frames tracked' if all_tracked else 'NOT all tracked'}, target met {met}/{len(rs)} seeds",
+                         f"ATE / static twin {statistics.mean(ratios):.2f} (max {max(ratios):.2f}); "
+                         f"without filter {min(none):.1f}-{max(none):.1f} mm"))
+        ks = next((t for t in tables(dyn) if t and "k" in t[0] and "fps (threaded, live dnn)" in t[0]), [])
+        for r in ks:
+            rows.append((f"Live threaded pipeline, YOLOX-nano, segment every {r['k']} frame(s)",
+                         f"{r['fps (threaded, live dnn)']} fps", f"ATE {r['ATE mm (tracked)']} mm (walking_xyz seed 1)"))
+    lines = ["| benchmark | frames | accuracy |", "|---|---|---|"]
+    lines += [f"| {a} | {b} | {c} |" for a, b, c in rows]
+    sources = []
+    for name in ("slam", "dynamic"):
+        body = section(bench_text, name)
+        if body:
+            sources.append(f"`{name}` ({stamp_date(body)})")
+    head = (f"_Condensed by `bench/readme_summary.py` from docs/BENCHMARKS.md sections "
+            f"{', '.join(sources) or '(none yet)'}; details, machine and settings there._\n\n")
+    return head + "\n".join(lines) + "\n"
+
+
+def main():
+    with open(os.path.join(ROOT, "docs", "BENCHMARKS.md")) as f:
+        bench = f.read()
+    readme_path = os.path.join(ROOT, "README.md")
+    with open(readme_path) as f:
+        readme = f.read()
+    if "<!-- BEGIN summary -->" not in readme or "<!-- END summary -->" not in readme:
+        print(f"{readme_path}: no '<!-- BEGIN summary -->' ... '<!-- END summary -->' markers", file=sys.stderr)
+        return 1
+    write_atomically(readme_path, replace_marked_block(readme, "summary", summary(bench)))
+    print(f"updated the benchmark summary of {readme_path}", file=sys.stderr)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
