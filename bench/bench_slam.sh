@@ -3,7 +3,8 @@
 #  - the real TUM clip fr2/desk (50 frames, ../shared): tracked fraction, ATE, timings, and that a
 #    second run with the same seed gives the identical trajectory;
 #  - synthetic `static` preset, three seeds: tracked fraction and ATE;
-#  - synthetic `loop` preset (no loop closing yet): tracked fraction, ATE and end drift;
+#  - synthetic `loop` preset (one lap and back over the start), loop closing on and off: tracked
+#    fraction, loops closed, ATE and end drift;
 # and writes the tables into docs/BENCHMARKS.md (section slam) via bench/update_section.py.
 # Usage: bench/bench_slam.sh [path/to/detslam]  (env: STATIC_FRAMES=600, SEEDS="1 2 3")
 set -euo pipefail
@@ -30,8 +31,11 @@ row() {  # name dataset_dir run_dir eval_json -> one markdown row
     "$(f1 "$(m field "$run/run.json" timings.local_mapping_per_keyframe.median_ms)") |"
 }
 
-run_eval() {  # dataset_dir out_dir [seed]
-  "$bin" run --dataset "$1" --out "$2" --seed "${3:-42}" --segmenter none --no-progress >"$2.log" 2>&1 || { cat "$2.log"; exit 1; }
+run_eval() {  # dataset_dir out_dir [seed [run options...]]
+  local ds=$1 o=$2 sd=${3:-42}
+  shift 2; [[ $# -gt 0 ]] && shift
+  "$bin" run --dataset "$ds" --out "$o" --seed "$sd" --segmenter none --no-progress "$@" >"$o.log" 2>&1 || { cat "$o.log"; exit 1; }
+  set -- "$ds" "$o"
   "$bin" eval --gt "$1/groundtruth.txt" --est "$2/trajectory.txt" --frames "$1" --json "$2/eval.json" >/dev/null
 }
 
@@ -83,17 +87,24 @@ done
 
 {
   echo
-  echo "### Synthetic \`loop\` preset (camera returns to its start; loop closing not implemented yet)"
+  echo "### Synthetic \`loop\` preset, 1050 frames (one 32 s lap around the room, then 3 s over its start again)"
   echo
-  echo "End drift: position error of the last frame after aligning only the first frame's pose."
+  echo "Loop closing on (default) and off (\`--set LoopClosing.Enabled=0\`). End drift: position error"
+  echo "of the last frame after aligning only the first frame's pose."
   echo
   echo "$header"
 } >>"$out"
-"$bin" synth --preset loop --seed 1 --out "$work/loop" >/dev/null 2>&1
-run_eval "$work/loop" "$work/loop_run"
-row "loop, seed 1" "$work/loop" "$work/loop_run" "$work/loop_run/eval.json" >>"$out"
-read -r drift length < <(m drift "$work/loop/groundtruth.txt" "$work/loop_run/trajectory.txt")
-python3 -c "print(f'\nEnd drift: {float($drift)*100:.1f} cm over a {float($length):.1f} m path ({float($drift)/float($length)*100:.2f} %).')" >>"$out"
+"$bin" synth --preset loop --seed 1 --frames 1050 --out "$work/loop" >/dev/null 2>&1
+drift_lines=""
+for mode in on off; do
+  opts=()
+  [[ $mode == off ]] && opts=(--set LoopClosing.Enabled=0)
+  run_eval "$work/loop" "$work/loop_$mode" 42 "${opts[@]}"
+  row "loop, seed 1, loop closing $mode ($(m field "$work/loop_$mode/run.json" loops_closed) closed)" "$work/loop" "$work/loop_$mode" "$work/loop_$mode/eval.json" >>"$out"
+  read -r drift length < <(m drift "$work/loop/groundtruth.txt" "$work/loop_$mode/trajectory.txt")
+  drift_lines+=$(python3 -c "print(f'End drift, loop closing $mode: {float($drift)*100:.1f} cm over a {float($length):.1f} m path ({float($drift)/float($length)*100:.2f} %).')")$'\n'
+done
+printf '\n%s' "$drift_lines" >>"$out"
 
 python3 "$here/update_section.py" slam "bench/bench_slam.sh (STATIC_FRAMES=$static_frames SEEDS=\"$seeds\")" <"$out"
 cat "$out"

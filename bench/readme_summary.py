@@ -64,9 +64,12 @@ def summary(bench_text):
             tracked = "all frames tracked" if all(r["tracked"].split("/")[0] == r["tracked"].split("/")[1] for r in static) else "NOT all tracked"
             rows.append((f"SLAM core, synthetic static ({len(static)} seeds)", tracked,
                          f"ATE RMSE {min(ates):.1f}-{max(ates):.1f} mm"))
-        m = re.search(r"End drift: ([0-9.]+ cm over a [0-9.]+ m path \([0-9.]+ %\))", slam)
-        if m:
-            rows.append(("SLAM core, synthetic loop (no loop closing yet)", "", f"end drift {m.group(1)}"))
+        loops = {r["sequence"]: r for t in tables(slam) for r in t if r.get("sequence", "").startswith("loop")}
+        drift = dict(re.findall(r"End drift, loop closing (on|off): ([0-9.]+ cm over a [0-9.]+ m path \([0-9.]+ %\))", slam))
+        for name, r in loops.items():
+            mode = "on" if "closing on" in name else "off"
+            rows.append((f"SLAM core, synthetic loop, loop closing {mode}", f"{r['tracked']} tracked",
+                         f"ATE RMSE {r['ATE RMSE mm']} mm; end drift {drift.get(mode, '?')}"))
     dyn = section(bench_text, "dynamic")
     if dyn:
         main = next((t for t in tables(dyn) if t and "ratio" in t[0]), [])

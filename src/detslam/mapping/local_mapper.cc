@@ -1,5 +1,7 @@
 #include "detslam/mapping/local_mapper.h"
 
+#include "detslam/mapping/map_bundle.h"
+
 #include <spdlog/spdlog.h>
 
 #include <chrono>
@@ -11,6 +13,7 @@
 #include "detslam/features/matcher.h"
 #include "detslam/optim/bundle_adjustment.h"
 #include "detslam/map/projection_search.h"
+#include "detslam/mapping/map_bundle.h"
 
 namespace detslam {
 
@@ -158,56 +161,15 @@ void LocalMapper::LocalBundleAdjustment(KeyFrameId current, LocalMappingSummary*
   std::sort(fixed_sorted.begin(), fixed_sorted.end());
   std::vector<KeyFrameId> fixed;
   for (size_t i = 0; i < fixed_sorted.size() && static_cast<int>(i) < options_.max_fixed_keyframes; ++i) fixed.push_back(fixed_sorted[i].second);
-  const KeyFrameId origin = map_->first_keyframe();
-  BundleProblem problem;
-  std::map<KeyFrameId, size_t> pose_index;
-  auto add_pose = [&](KeyFrameId k, bool is_fixed) {
-    pose_index[k] = problem.poses.size();
-    problem.poses.push_back({k, map_->keyframe(k).cam_from_world, is_fixed || k == origin});
-  };
-  for (KeyFrameId k : local) add_pose(k, false);
-  for (KeyFrameId k : fixed) add_pose(k, true);
-  bool any_fixed = false;
-  for (const auto& p : problem.poses) any_fixed |= p.fixed;
-  if (!any_fixed) return;  // no gauge: ORB-SLAM skips local BA then
-  std::vector<std::pair<LandmarkId, KeyFrameId>> obs_ref;
-  for (size_t pi = 0; pi < points.size(); ++pi) {
-    const Landmark& lm = map_->landmark(points[pi]);
-    problem.points.push_back({lm.id, lm.position, false});
-    for (const auto& [kf, idx] : lm.observations) {
-      auto it = pose_index.find(kf);
-      if (it == pose_index.end()) continue;
-      const FrameFeatures& f = *map_->keyframe(kf).features;
-      BundleProblem::Observation o;
-      o.pose_index = it->second;
-      o.point_index = pi;
-      o.uv = f.undist[idx];
-      o.u_right = f.u_right[idx];
-      o.inv_sigma2 = map_->scale().inv_level_sigma2[static_cast<size_t>(f.keypoints[idx].octave)];
-      problem.observations.push_back(o);
-      obs_ref.emplace_back(lm.id, kf);
-    }
-  }
+  MapBundle bundle = BuildMapBundle(*map_, local, fixed);
+  if (bundle.problem.poses.empty()) return;  // no gauge: ORB-SLAM skips local BA then
   BundleOptions bo;
   bo.max_iterations = options_.ba_iterations;
   if (lock->owns_lock()) lock->unlock();  // solve on the copy while tracking goes on
-  const BundleSummary s = SolveBundle(camera_, &problem, bo);
+  const BundleSummary s = SolveBundle(camera_, &bundle.problem, bo);
   if (lock->mutex() != nullptr) lock->lock();
   if (!s.usable) return;
-  for (size_t k = 0; k < problem.observations.size(); ++k) {
-    if (s.outlier[k] && map_->HasLandmark(obs_ref[k].first)) {
-      map_->EraseObservation(obs_ref[k].first, obs_ref[k].second);
-      ++summary->ba_outliers;
-    }
-  }
-  for (const auto& p : problem.poses) {
-    if (!p.fixed && map_->HasKeyFrame(p.id)) map_->keyframe(p.id).cam_from_world = p.cam_from_world;
-  }
-  for (const auto& p : problem.points) {
-    if (!map_->HasLandmark(p.id)) continue;
-    map_->landmark(p.id).position = p.p_world;
-    map_->UpdateLandmarkGeometry(p.id);
-  }
+  summary->ba_outliers += ApplyMapBundle(bundle, s, map_);
   summary->ba_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }
 

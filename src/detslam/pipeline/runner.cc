@@ -55,6 +55,7 @@ void WriteOutputs(const RgbdDataset& dataset, const Settings& settings, const Ru
   j["keyframes"] = summary.keyframes;
   j["map_points"] = summary.landmarks;
   j["relocalizations"] = summary.relocalizations;
+  j["loops_closed"] = summary.loops;
   j["wall_s"] = summary.wall_s;
   j["segmenter"] = summary.segmenter.empty() ? "none" : summary.segmenter;
   j["dynamic_filter"] = {{"classes", options.slam.dynamic.dynamic_classes}, {"alpha", options.slam.dynamic.alpha},
@@ -67,7 +68,7 @@ void WriteOutputs(const RgbdDataset& dataset, const Settings& settings, const Ru
   for (const FrameReport& r : summary.reports) {
     per_frame.push_back({{"index", r.index}, {"stamp", r.stamp.Seconds()}, {"state", ToString(r.tracking.state)},
                          {"tracked", r.tracking.pose_valid}, {"method", r.tracking.method},
-                         {"inliers", r.tracking.num_inliers}, {"keyframe", r.keyframe},
+                         {"inliers", r.tracking.num_inliers}, {"keyframe", r.keyframe}, {"loop_closed", r.loop_closed},
                          {"keypoints", r.num_keypoints}, {"dynamic_instances", r.dynamic_instances},
                          {"rejected_keypoints", r.rejected_keypoints}, {"geometric_rejected", r.tracking.geometric_rejected},
                          {"segmentation_ms", r.segmentation_ms},
@@ -92,6 +93,9 @@ SlamOptions SlamOptionsFromSettings(const Settings& settings, uint64_t seed) {
   o.tracker.keyframe_far_points = settings.GetInt("Tracking.KeyFrameFarPoints", o.tracker.keyframe_far_points);
   o.mapper.local_ba = settings.GetBool("LocalMapping.BundleAdjustment", o.mapper.local_ba);
   o.mapper.max_local_keyframes = settings.GetInt("LocalMapping.MaxLocalKeyFrames", o.mapper.max_local_keyframes);
+  o.loop.enabled = settings.GetBool("LoopClosing.Enabled", o.loop.enabled);
+  o.loop.candidate_radius_m = settings.GetDouble("LoopClosing.CandidateRadius", o.loop.candidate_radius_m);
+  o.loop.global_ba_iterations = settings.GetInt("LoopClosing.GlobalBAIterations", o.loop.global_ba_iterations);
   o.dynamic.alpha = settings.GetDouble("Dynamic.Alpha", o.dynamic.alpha);
   o.dynamic.depth_step = settings.GetBool("Dynamic.DepthStep", o.dynamic.depth_step);
   o.dynamic.mask_dilation_px = settings.GetInt("Dynamic.MaskDilation", o.dynamic.mask_dilation_px);
@@ -128,6 +132,7 @@ class RunRecorder {
     ++summary_.frames;
     if (r.tracking.pose_valid) ++summary_.tracked;
     if (r.tracking.relocalized) ++summary_.relocalizations;
+    if (r.loop_closed) ++summary_.loops;
     if (r.segmentation_ms > 0) seg_.push_back(r.segmentation_ms);
     ext_.push_back(r.timings.extraction_ms);
     trk_.push_back(r.timings.tracking_ms);
@@ -142,6 +147,7 @@ class RunRecorder {
     slam.Finish();  // drain the mapping thread before reading the map
     if (segmenter != nullptr) summary_.segmenter = segmenter->name();
     summary_.segmentation = ComputeErrorStats(seg_);
+    summary_.loops = static_cast<size_t>(slam.loops_closed());
     summary_.keyframes = slam.map().NumKeyFrames();
     summary_.landmarks = slam.map().NumLandmarks();
     summary_.extraction = ComputeErrorStats(ext_);

@@ -34,6 +34,7 @@ struct RunSummary {
   size_t keyframes = 0;
   size_t landmarks = 0;
   size_t relocalizations = 0;
+  size_t loops = 0;  // loops closed
   double wall_s = 0;
   ErrorStats segmentation, extraction, tracking, mapping, total;  // per-stage times, ms
   std::string segmenter;  // backend name, empty without segmentation

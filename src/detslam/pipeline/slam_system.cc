@@ -16,9 +16,9 @@ double MsSince(std::chrono::steady_clock::time_point t0) {
 }  // namespace
 
 bool SlamOptions::Check(std::string* error) const {
-  std::string e1, e2, e3, e4;
-  const bool ok = orb.Check(&e1) & tracker.Check(&e2) & mapper.Check(&e3) & dynamic.Check(&e4);
-  if (error) *error = e1 + e2 + e3 + e4;
+  std::string e1, e2, e3, e4, e5;
+  const bool ok = orb.Check(&e1) & tracker.Check(&e2) & mapper.Check(&e3) & dynamic.Check(&e4) & loop.Check(&e5);
+  if (error) *error = e1 + e2 + e3 + e4 + e5;
   return ok;
 }
 
@@ -37,7 +37,8 @@ SlamSystem::SlamSystem(const PinholeCamera& camera, const SlamOptions& options)
       extractor_(options.orb),
       map_(MakeScaleInfo(extractor_)),
       tracker_(camera, options.tracker, &map_),
-      mapper_(camera, options.mapper, &map_) {
+      mapper_(camera, options.mapper, &map_),
+      loop_closer_(camera, options.loop, &map_) {
   std::string error;
   DETSLAM_CHECK_MSG(camera_.Check(&error), error);
   if (options_.mapping_thread) {
@@ -69,6 +70,11 @@ void SlamSystem::MapKeyFrame(KeyFrameId kf, FrameReport* report) {
   for (const ErasedKeyFrame& e : s.erased_keyframes) {
     erased_[e.id] = e;
     tracker_.OnKeyFrameErased(e.id);
+  }
+  const LoopClosingResult loop = loop_closer_.Process(kf);
+  if (loop.closed) {
+    tracker_.OnLoopClosed(loop.old_poses);
+    report->loop_closed = true;
   }
   report->timings.mapping_ms = MsSince(t0);
   mapping_times_ms_.push_back(report->timings.mapping_ms);

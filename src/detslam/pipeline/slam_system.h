@@ -14,6 +14,7 @@
 #include "detslam/dynamic/dynamic_filter.h"
 #include "detslam/features/orb_extractor.h"
 #include "detslam/io/trajectory.h"
+#include "detslam/loop/loop_closer.h"
 #include "detslam/map/map.h"
 #include "detslam/mapping/local_mapper.h"
 #include "detslam/pipeline/bounded_queue.h"
@@ -25,6 +26,7 @@ struct SlamOptions {
   OrbOptions orb;
   TrackerOptions tracker;
   LocalMapperOptions mapper;
+  LoopClosingOptions loop;        // loop closing after local mapping of each keyframe
   DynamicFilterOptions dynamic;   // Det-SLAM filter (used when instances are passed in)
   bool dynamic_premask = true;    // also drop dynamic corners before the ORB spatial distribution
   bool mapping_thread = false;    // local mapping in its own thread (not deterministic)
@@ -45,6 +47,7 @@ struct FrameReport {
   Timestamp stamp;
   TrackingResult tracking;
   bool keyframe = false;
+  bool loop_closed = false;   // this frame's keyframe closed a loop (sequential/inline mapping)
   int num_keypoints = 0;
   FrameTimings timings;
 };
@@ -82,6 +85,8 @@ class SlamSystem {
   const Map& map() const { return map_; }
   // Local-mapping time of every processed keyframe (ms), in processing order.
   const std::vector<double>& mapping_times_ms() const { return mapping_times_ms_; }
+  // Loops closed so far.
+  int loops_closed() const { return loop_closer_.loops_closed(); }
 
  private:
   Rigid3d ReferenceWorldFromCam(KeyFrameId id, const Rigid3d& cam_from_ref) const;
@@ -102,6 +107,7 @@ class SlamSystem {
   std::vector<TrackedFrame> tracked_;
   std::map<KeyFrameId, ErasedKeyFrame> erased_;
   std::vector<double> mapping_times_ms_;
+  LoopCloser loop_closer_;
   // Mapping thread: the map store's one lock guards map_, tracker_ state and erased_ while both
   // threads run; the queue hands keyframes from tracking to mapping.
   std::mutex map_mutex_;

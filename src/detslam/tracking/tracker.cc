@@ -48,6 +48,15 @@ void Tracker::OnKeyFrameErased(KeyFrameId id) {
   if (last_keyframe_ == id) last_keyframe_ = reference_kf_;
 }
 
+void Tracker::OnLoopClosed(const std::map<KeyFrameId, Rigid3d>& old_poses) {
+  if (!last_frame_ || !last_frame_->cam_from_world) return;
+  KeyFrameId ref = last_frame_->reference_keyframe;
+  if (!map_->HasKeyFrame(ref) || !old_poses.count(ref)) ref = reference_kf_;
+  if (!map_->HasKeyFrame(ref) || !old_poses.count(ref)) return;
+  last_frame_->cam_from_world = *last_frame_->cam_from_world * old_poses.at(ref).Inverse() * map_->keyframe(ref).cam_from_world;
+  BuildTemporaryPoints();
+}
+
 TrackingResult Tracker::Track(Frame* frame) {
   TrackingResult result;
   frame->landmarks.assign(frame->size(), kNoLandmark);

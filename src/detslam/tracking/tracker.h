@@ -5,6 +5,7 @@
 #pragma once
 
 #include <deque>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -72,6 +73,9 @@ class Tracker {
   KeyFrameId reference_keyframe() const { return reference_kf_; }
   // Called by the mapper when a keyframe has been erased, so the tracker drops references.
   void OnKeyFrameErased(KeyFrameId id);
+  // Called after loop closing moved the keyframes (`old_poses`: their poses before): moves the
+  // last frame with its reference keyframe.
+  void OnLoopClosed(const std::map<KeyFrameId, Rigid3d>& old_poses);
 
  private:
   bool Initialize(Frame* frame);

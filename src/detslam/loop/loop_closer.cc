@@ -1,0 +1,247 @@
+#include "detslam/loop/loop_closer.h"
+
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <set>
+#include <sstream>
+
+#include "detslam/core/check.h"
+#include "detslam/features/matcher.h"
+#include "detslam/geometry/rigid_ransac.h"
+#include "detslam/map/projection_search.h"
+#include "detslam/mapping/map_bundle.h"
+#include "detslam/optim/pose_graph.h"
+#include "detslam/optim/pose_optimizer.h"
+
+namespace detslam {
+
+bool LoopClosingOptions::Check(std::string* error) const {
+  std::ostringstream os;
+  if (min_keyframe_gap < 1) os << "min_keyframe_gap must be >= 1; ";
+  if (!(candidate_radius_m > 0)) os << "candidate_radius_m must be positive; ";
+  if (max_candidates < 1) os << "max_candidates must be >= 1; ";
+  if (min_matches < 3 || min_ransac_inliers < 3) os << "min_matches and min_ransac_inliers must be >= 3; ";
+  if (!(ransac_inlier_m > 0)) os << "ransac_inlier_m must be positive; ";
+  if (min_verified_inliers < 3) os << "min_verified_inliers must be >= 3; ";
+  if (error) *error = os.str();
+  return os.str().empty();
+}
+
+LoopCloser::LoopCloser(const PinholeCamera& camera, LoopClosingOptions options, Map* map)
+    : camera_(camera), options_(options), map_(map), rng_(options.seed) {
+  std::string error;
+  DETSLAM_CHECK_MSG(options_.Check(&error), "invalid LoopClosingOptions: " << error);
+}
+
+LoopClosingResult LoopCloser::Process(KeyFrameId kf_id) {
+  LoopClosingResult result;
+  result.keyframe = kf_id;
+  if (!options_.enabled || !map_->HasKeyFrame(kf_id)) return result;
+  if (last_loop_kf_ != kNoKeyFrame && kf_id - last_loop_kf_ < 5) return result;
+  const KeyFrame& kf = map_->keyframe(kf_id);
+  const Eigen::Vector3d center = kf.Center();
+  std::vector<std::pair<double, KeyFrameId>> near;
+  for (const auto& [id, other] : map_->keyframes()) {
+    if (id > kf_id - options_.min_keyframe_gap) break;  // ids ascend
+    if (kf.covisibility.count(id)) continue;
+    const double d = (other.Center() - center).norm();
+    if (d < options_.candidate_radius_m) near.emplace_back(d, id);
+  }
+  std::sort(near.begin(), near.end());
+  spdlog::debug("keyframe {}: {} loop candidates within {} m", kf_id, near.size(), options_.candidate_radius_m);
+  if (near.size() > static_cast<size_t>(options_.max_candidates)) near.resize(static_cast<size_t>(options_.max_candidates));
+  for (const auto& [d, candidate] : near) {
+    (void)d;
+    Verified loop;
+    if (!Verify(kf_id, candidate, &loop)) continue;
+    Correct(kf_id, loop, &result);
+    result.closed = true;
+    result.candidate = candidate;
+    result.inliers = loop.inliers;
+    last_loop_kf_ = kf_id;
+    ++loops_closed_;
+    spdlog::info("loop closed: keyframe {} with keyframe {} ({} inliers, {} landmarks fused, correction {:.3f} m)",
+                 kf_id, candidate, loop.inliers, result.fused, result.correction_m);
+    break;
+  }
+  return result;
+}
+
+bool LoopCloser::Verify(KeyFrameId kf_id, KeyFrameId candidate_id, Verified* out) {
+  const KeyFrame& kf = map_->keyframe(kf_id);
+  const FrameFeatures& f = *kf.features;
+  std::vector<LandmarkId> matched = MatchKeyFrameLandmarks(map_->keyframe(candidate_id), f, 0.9, kThHigh);
+  std::vector<Eigen::Vector3d> world, cam;
+  std::vector<size_t> kp;
+  for (size_t i = 0; i < f.size(); ++i) {
+    if (matched[i] == kNoLandmark || f.depth[i] <= 0 || !map_->HasLandmark(matched[i])) continue;
+    world.push_back(map_->landmark(matched[i]).position);
+    cam.push_back(camera_.Unproject(f.undist[i], f.depth[i]));
+    kp.push_back(i);
+  }
+  spdlog::debug("loop candidate {} for keyframe {}: {} matches with depth", candidate_id, kf_id, kp.size());
+  if (static_cast<int>(kp.size()) < options_.min_matches) return false;
+  RansacOptions ro;
+  ro.min_inliers = options_.min_ransac_inliers;
+  const RigidRansacResult rr = EstimateRigidRansac(world, cam, options_.ransac_inlier_m, ro, rng_);
+  spdlog::debug("  rigid RANSAC: {} inliers", rr.num_inliers);
+  if (!rr.success) return false;
+
+  // Pose-only refinement, then more matches from the candidate's neighbourhood by projection.
+  std::vector<LandmarkId> assoc(f.size(), kNoLandmark);
+  for (size_t k = 0; k < kp.size(); ++k) {
+    if (rr.inliers[k]) assoc[kp[k]] = matched[kp[k]];
+  }
+  Rigid3d pose = rr.b_from_a;
+  auto optimise = [&]() {
+    std::vector<PoseObservation> obs;
+    std::vector<size_t> idx;
+    for (size_t i = 0; i < f.size(); ++i) {
+      if (assoc[i] == kNoLandmark) continue;
+      PoseObservation o;
+      o.point_world = map_->landmark(assoc[i]).position;
+      o.uv = f.undist[i];
+      o.u_right = f.u_right[i];
+      o.inv_sigma2 = map_->scale().inv_level_sigma2[static_cast<size_t>(f.keypoints[i].octave)];
+      obs.push_back(o);
+      idx.push_back(i);
+    }
+    if (obs.size() < 3) return 0;
+    const PoseOptimizerResult r = OptimizePose(camera_, pose, obs, PoseOptimizerOptions());
+    pose = r.cam_from_world;
+    for (size_t k = 0; k < obs.size(); ++k) {
+      if (!r.inliers[k]) assoc[idx[k]] = kNoLandmark;
+    }
+    return r.num_inliers;
+  };
+  if (optimise() < options_.min_ransac_inliers) return false;
+  std::vector<KeyFrameId> neighbourhood = map_->BestCovisibles(candidate_id, 10);
+  neighbourhood.push_back(candidate_id);
+  std::set<LandmarkId> seen(assoc.begin(), assoc.end());
+  std::vector<ProjectionCandidate> candidates;
+  for (KeyFrameId n : neighbourhood) {
+    for (LandmarkId lm : map_->keyframe(n).landmarks) {
+      if (lm != kNoLandmark && map_->HasLandmark(lm) && seen.insert(lm).second) {
+        candidates.push_back(CandidateFromLandmark(map_->landmark(lm)));
+      }
+    }
+  }
+  std::vector<bool> taken(f.size());
+  for (size_t i = 0; i < f.size(); ++i) taken[i] = assoc[i] != kNoLandmark;
+  ProjectionSearchOptions po;
+  po.window = 10;
+  po.ratio = 0.9;
+  const std::vector<int> m = SearchByProjection(camera_, map_->scale(), f, pose, candidates, taken, po);
+  for (size_t c = 0; c < candidates.size(); ++c) {
+    if (m[c] >= 0) assoc[static_cast<size_t>(m[c])] = candidates[c].landmark;
+  }
+  const int inliers = optimise();
+  spdlog::debug("  verified: {} pose-only inliers", inliers);
+  if (inliers < options_.min_verified_inliers) return false;
+  out->candidate = candidate_id;
+  out->cam_from_world = pose;
+  out->matched = std::move(assoc);
+  out->inliers = inliers;
+  return true;
+}
+
+void LoopCloser::Correct(KeyFrameId kf_id, const Verified& loop, LoopClosingResult* result) {
+  // Poses and positions before the correction.
+  std::map<KeyFrameId, Rigid3d> old_pose;
+  for (const auto& [id, k] : map_->keyframes()) old_pose[id] = k.cam_from_world;
+  std::map<LandmarkId, Eigen::Vector3d> old_position;
+  for (const auto& [id, lm] : map_->landmarks()) old_position[id] = lm.position;
+
+  // The keyframe's neighbourhood moves rigidly with it: world_new_from_world_old.
+  const Rigid3d correction = loop.cam_from_world.Inverse() * old_pose.at(kf_id);
+  std::vector<KeyFrameId> group = map_->BestCovisibles(kf_id, 1000);
+  group.push_back(kf_id);
+  const std::set<KeyFrameId> in_group(group.begin(), group.end());
+  std::map<KeyFrameId, std::set<KeyFrameId>> connected_before;
+  for (KeyFrameId g : group) {
+    for (const auto& [n, w] : map_->keyframe(g).covisibility) {
+      (void)w;
+      connected_before[g].insert(n);
+    }
+  }
+  std::map<KeyFrameId, Rigid3d> initial = old_pose;
+  for (KeyFrameId g : group) initial[g] = old_pose.at(g) * correction.Inverse();
+
+  // Fuse the keyframe's landmarks into the loop landmarks they matched.
+  KeyFrame& kf = map_->keyframe(kf_id);
+  for (size_t i = 0; i < loop.matched.size(); ++i) {
+    const LandmarkId into = loop.matched[i];
+    if (into == kNoLandmark || !map_->HasLandmark(into)) continue;
+    const LandmarkId current = kf.landmarks[i];
+    if (current == into) continue;
+    if (current != kNoLandmark && map_->HasLandmark(current)) {
+      map_->ReplaceLandmark(current, into);
+    } else if (!map_->landmark(into).observations.count(kf_id)) {
+      map_->AddObservation(into, kf_id, i);
+    } else {
+      continue;
+    }
+    ++result->fused;
+  }
+  for (KeyFrameId g : group) map_->UpdateConnections(g);
+
+  // Essential graph: spanning tree, strong covisibility, and the new loop connections.
+  PoseGraphProblem problem;
+  std::map<KeyFrameId, size_t> node;
+  for (const auto& [id, k] : map_->keyframes()) {
+    (void)k;
+    node[id] = problem.nodes.size();
+    PoseGraphProblem::Node n;
+    n.id = id;
+    n.cam_from_world = initial.at(id);
+    n.fixed = id == map_->first_keyframe();
+    problem.nodes.push_back(n);
+  }
+  std::set<std::pair<KeyFrameId, KeyFrameId>> added;
+  auto add_edge = [&](KeyFrameId a, KeyFrameId b, const std::map<KeyFrameId, Rigid3d>& poses) {
+    if (a == b || !node.count(a) || !node.count(b)) return;
+    if (!added.insert({std::min(a, b), std::max(a, b)}).second) return;
+    PoseGraphProblem::Edge e;
+    e.from = node.at(a);
+    e.to = node.at(b);
+    e.from_from_to = poses.at(a) * poses.at(b).Inverse();
+    problem.edges.push_back(e);
+  };
+  // Loop edges first (measured with the corrected group poses).
+  add_edge(kf_id, loop.candidate, initial);
+  for (KeyFrameId g : group) {
+    for (const auto& [n, w] : map_->keyframe(g).covisibility) {
+      (void)w;
+      if (!in_group.count(n) && !connected_before[g].count(n)) add_edge(g, n, initial);
+    }
+  }
+  for (const auto& [id, k] : map_->keyframes()) {
+    if (k.parent != kNoKeyFrame) add_edge(id, k.parent, old_pose);
+    for (const auto& [n, w] : k.covisibility) {
+      if (w >= options_.essential_min_weight) add_edge(id, n, old_pose);
+    }
+  }
+  const PoseGraphSummary s = SolvePoseGraph(&problem, PoseGraphOptions());
+  if (!s.usable) spdlog::warn("loop closing: pose graph optimisation did not converge; using its last state");
+  for (const PoseGraphProblem::Node& n : problem.nodes) map_->keyframe(n.id).cam_from_world = n.cam_from_world;
+
+  // Every landmark moves with its reference keyframe.
+  for (const auto& [id, pos] : old_position) {
+    if (!map_->HasLandmark(id)) continue;
+    Landmark& lm = map_->landmark(id);
+    KeyFrameId ref = lm.reference_keyframe;
+    if (!map_->HasKeyFrame(ref) || !old_pose.count(ref)) {
+      if (lm.observations.empty()) continue;
+      ref = lm.observations.begin()->first;
+    }
+    if (!old_pose.count(ref)) continue;
+    lm.position = map_->keyframe(ref).cam_from_world.Inverse() * (old_pose.at(ref) * pos);
+    map_->UpdateLandmarkGeometry(id);
+  }
+  if (options_.global_ba_iterations > 0) GlobalBundleAdjustment(camera_, options_.global_ba_iterations, map_);
+  result->correction_m = (map_->keyframe(kf_id).Center() - old_pose.at(kf_id).Inverse().translation()).norm();
+  result->old_poses = std::move(old_pose);
+}
+
+}  // namespace detslam

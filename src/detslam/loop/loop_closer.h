@@ -1,0 +1,77 @@
+// Loop closing for RGB-D: after local mapping of a keyframe, look for an older keyframe of the
+// same place that is not in its covisibility neighbourhood, verify the loop geometrically (3-D to
+// 3-D rigid RANSAC on descriptor matches with the keyframe's depth, then pose-only optimisation
+// with more matches by projection), fuse the duplicated landmarks, and distribute the correction
+// over the map by a pose-graph optimisation (spanning tree, strong covisibility edges, loop edges;
+// ORB-SLAM's essential graph), moving every landmark with its reference keyframe, then a bundle
+// adjustment of the whole map.
+//
+// Place recognition has no bag-of-words index yet: candidates are the keyframes whose centre lies
+// within `candidate_radius_m` of the keyframe's (drift up to about that radius is recovered),
+// nearest first, at most `max_candidates` per keyframe, ranked by brute-force descriptor matches.
+#pragma once
+
+#include <map>
+#include <string>
+#include <vector>
+
+#include "detslam/core/camera.h"
+#include "detslam/core/rng.h"
+#include "detslam/map/map.h"
+
+namespace detslam {
+
+struct LoopClosingOptions {
+  bool enabled = true;
+  int min_keyframe_gap = 20;          // candidates at least this many keyframe ids older
+  double candidate_radius_m = 1.5;    // candidate keyframe centres within this distance
+  int max_candidates = 8;             // examined per keyframe (nearest first)
+  int min_matches = 40;               // descriptor matches with depth to try RANSAC
+  double ransac_inlier_m = 0.05;      // 3-D inlier distance (scaled by depth / 2 m, at least this)
+  int min_ransac_inliers = 30;
+  int min_verified_inliers = 80;      // pose-only inliers after the projection search
+  int essential_min_weight = 100;     // covisibility edges kept in the pose graph
+  int global_ba_iterations = 10;      // bundle adjustment of the whole map after the pose graph (0: none)
+  uint64_t seed = 7;                  // RANSAC
+  bool Check(std::string* error) const;
+};
+
+struct LoopClosingResult {
+  bool closed = false;
+  KeyFrameId keyframe = kNoKeyFrame;   // the keyframe that closed the loop
+  KeyFrameId candidate = kNoKeyFrame;  // the older keyframe of the same place
+  int inliers = 0;                     // verified pose-only inliers
+  int fused = 0;                       // landmarks merged
+  double correction_m = 0;             // how far the keyframe moved
+  // Keyframe poses before the correction (cam_from_world), for the tracker and the trajectory.
+  std::map<KeyFrameId, Rigid3d> old_poses;
+};
+
+class LoopCloser {
+ public:
+  LoopCloser(const PinholeCamera& camera, LoopClosingOptions options, Map* map);
+
+  // Looks for and closes a loop at keyframe `kf` (which must exist). Deterministic.
+  LoopClosingResult Process(KeyFrameId kf);
+
+  int loops_closed() const { return loops_closed_; }
+
+ private:
+  struct Verified {
+    KeyFrameId candidate = kNoKeyFrame;
+    Rigid3d cam_from_world;                  // corrected pose of the current keyframe
+    std::vector<LandmarkId> matched;         // per keypoint of the current keyframe
+    int inliers = 0;
+  };
+  bool Verify(KeyFrameId kf, KeyFrameId candidate, Verified* out);
+  void Correct(KeyFrameId kf, const Verified& loop, LoopClosingResult* result);
+
+  PinholeCamera camera_;
+  LoopClosingOptions options_;
+  Map* map_;
+  Rng rng_;
+  KeyFrameId last_loop_kf_ = kNoKeyFrame;
+  int loops_closed_ = 0;
+};
+
+}  // namespace detslam

@@ -1,0 +1,59 @@
+// Loop closing on the synthetic `loop` preset (the camera walks around the room and comes back to
+// its start): the loop must be detected and closed, every frame tracked, and the trajectory must
+// be far more accurate than with loop closing off (measured: 106 mm against 212 mm ATE RMSE).
+#include <gtest/gtest.h>
+
+#include <opencv2/imgproc.hpp>
+
+#include "detslam/eval/ate.h"
+#include "detslam/pipeline/slam_system.h"
+#include "detslam/synth/sequence.h"
+
+namespace detslam {
+namespace {
+
+struct LoopRun {
+  int tracked = 0;
+  int frames = 0;
+  int loops = 0;
+  double ate_m = 0;
+};
+
+LoopRun RunLoopPreset(const SyntheticSequence& seq, bool loop_closing) {
+  SlamOptions options;
+  options.loop.enabled = loop_closing;
+  SlamSystem slam(seq.camera(), options);
+  Trajectory gt;
+  LoopRun run;
+  for (int k = 0; k < seq.size(); ++k) {
+    const SynthFrame f = seq.Render(k);
+    cv::Mat gray, depth;
+    cv::cvtColor(f.bgr, gray, cv::COLOR_BGR2GRAY);
+    f.depth16.convertTo(depth, CV_32F, 1.0 / seq.camera().depth_map_factor);
+    const FrameReport r = slam.ProcessFrame(k, f.stamp, gray, depth);
+    run.tracked += r.tracking.pose_valid ? 1 : 0;
+    ++run.frames;
+    gt.push_back({f.stamp, f.world_from_cam});
+  }
+  slam.Finish();
+  run.loops = slam.loops_closed();
+  run.ate_m = ComputeAte(gt, slam.FrameTrajectory(), AteOptions()).error_m.rmse;
+  return run;
+}
+
+TEST(IntegrationLoopClosing, ClosesTheLoopOfTheLoopPreset) {
+  SynthOptions so;
+  so.preset = "loop";
+  so.seed = 1;
+  so.frames = 1050;  // one 32 s lap and 3 s over the start again
+  const SyntheticSequence seq(so);
+  const LoopRun without = RunLoopPreset(seq, false);
+  const LoopRun with = RunLoopPreset(seq, true);
+  EXPECT_EQ(without.loops, 0);
+  EXPECT_GE(with.loops, 1);
+  EXPECT_EQ(with.tracked, with.frames);
+  EXPECT_LT(with.ate_m, 0.6 * without.ate_m) << "ATE with loop closing " << with.ate_m << " m, without " << without.ate_m << " m";
+}
+
+}  // namespace
+}  // namespace detslam
