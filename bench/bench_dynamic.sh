@@ -140,3 +140,4 @@ done
 } >"$work/section.md"
 python3 "$here/update_section.py" dynamic "bench/bench_dynamic.sh (PRESETS=\"$presets\" SEEDS=\"$seeds\" FRAMES=$frames JOBS=$jobs KS=\"$ks\")" <"$work/section.md"
 cat "$work/section.md"
+python3 "$here/readme_summary.py"

@@ -108,3 +108,4 @@ printf '\n%s' "$drift_lines" >>"$out"
 
 python3 "$here/update_section.py" slam "bench/bench_slam.sh (STATIC_FRAMES=$static_frames SEEDS=\"$seeds\")" <"$out"
 cat "$out"
+python3 "$here/readme_summary.py"
