@@ -1,7 +1,5 @@
 #include "detslam/mapping/local_mapper.h"
 
-#include "detslam/mapping/map_bundle.h"
-
 #include <spdlog/spdlog.h>
 
 #include <chrono>

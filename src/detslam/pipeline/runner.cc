@@ -132,7 +132,6 @@ class RunRecorder {
     ++summary_.frames;
     if (r.tracking.pose_valid) ++summary_.tracked;
     if (r.tracking.relocalized) ++summary_.relocalizations;
-    if (r.loop_closed) ++summary_.loops;
     if (r.segmentation_ms > 0) seg_.push_back(r.segmentation_ms);
     ext_.push_back(r.timings.extraction_ms);
     trk_.push_back(r.timings.tracking_ms);
@@ -198,13 +197,11 @@ LoadedFrame LoadAndSegment(const RgbdDataset& dataset, const Settings& settings,
   LoadedFrame f;
   f.index = static_cast<int64_t>(i);
   f.images = dataset.Load(i, settings.camera);
-  if (segmenter != nullptr && state->every > 1 && i % static_cast<size_t>(state->every) != 0) {
-    const auto t0 = std::chrono::steady_clock::now();
+  if (segmenter == nullptr) return f;
+  const auto t0 = std::chrono::steady_clock::now();
+  if (state->every > 1 && i % static_cast<size_t>(state->every) != 0) {
     f.instances = state->propagator.Propagate(f.images.gray);
-    f.segmented = true;
-    f.segmentation_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-  } else if (segmenter != nullptr) {
-    const auto t0 = std::chrono::steady_clock::now();
+  } else {
     SegmenterInput in;
     in.index = f.index;
     in.stamp = dataset.frame(i).rgb_stamp;
@@ -212,9 +209,9 @@ LoadedFrame LoadAndSegment(const RgbdDataset& dataset, const Settings& settings,
     in.depth_m = f.images.depth_m;
     f.instances = state->memory.Update(segmenter->Segment(in));
     if (state->every > 1) state->propagator.Reset(f.images.gray, f.instances);
-    f.segmented = true;
-    f.segmentation_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   }
+  f.segmented = true;
+  f.segmentation_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   return f;
 }
 
