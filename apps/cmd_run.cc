@@ -32,28 +32,10 @@ struct RunArgs {
   double alpha = -1;
   bool no_depth_step = false;
   bool geometric_check = false;
+  bool no_geometric_check = false;
   int segment_every = 0;  // 0: from the settings (Segmentation.EveryK, default 1)
   std::vector<std::string> overrides;  // --set KEY=VALUE
 };
-
-// Applies --set KEY=VALUE to the settings' extra keys (Tracking.*, LocalMapping.*, Dynamic.*,
-// Segmentation.*); camera and ORB keys must come from the settings file.
-void ApplyOverrides(const std::vector<std::string>& overrides, Settings* settings) {
-  for (const std::string& o : overrides) {
-    const size_t eq = o.find('=');
-    if (eq == std::string::npos || eq == 0 || eq + 1 == o.size()) {
-      throw InputError("--set " + o + ": expected KEY=VALUE, e.g. --set Dynamic.Alpha=0.2");
-    }
-    const std::string key = o.substr(0, eq);
-    for (const char* typed : {"Camera", "Camera1.", "Camera.", "Stereo.", "RGBD.", "ORBextractor."}) {
-      if (key.rfind(typed, 0) == 0) {
-        throw InputError("--set " + o + ": camera and ORB keys come from the settings file (--config)");
-      }
-    }
-    settings->extra[key] = o.substr(eq + 1);
-  }
-  if (!overrides.empty()) settings->source += " + --set overrides";
-}
 
 // A one-line progress bar on stderr when it is a terminal; otherwise a log line every 100 frames.
 class ProgressBar {
@@ -85,7 +67,7 @@ void Run(const RunArgs& a) {
   dopt.association_file = a.association;
   const RgbdDataset dataset = RgbdDataset::Open(a.dataset, dopt);
   Settings settings = a.config.empty() ? PresetForDataset(a.dataset) : ReadSettings(a.config);
-  ApplyOverrides(a.overrides, &settings);
+  ApplySettingOverrides(a.overrides, &settings);
   RunOptions options;
   options.out_dir = a.out;
   options.max_frames = a.max_frames;
@@ -95,6 +77,7 @@ void Run(const RunArgs& a) {
   if (a.alpha >= 0) options.slam.dynamic.alpha = a.alpha;
   if (a.no_depth_step) options.slam.dynamic.depth_step = false;
   if (a.geometric_check) options.slam.tracker.geometric_check = true;
+  if (a.no_geometric_check) options.slam.tracker.geometric_check = false;
   options.segment_every = a.segment_every > 0 ? a.segment_every : settings.GetInt("Segmentation.EveryK", 1);
   if (options.segment_every < 1) throw InputError(settings.source, 0, "Segmentation.EveryK must be >= 1");
   std::string error;
@@ -148,8 +131,9 @@ void AddRunCommand(CLI::App& app) {
   cmd->add_option("--models", args->models, "Models folder for --segmenter dnn (default $DETSLAM_MODELS or ../shared/models)");
   cmd->add_option("--alpha", args->alpha, "Det-SLAM depth-step widening factor alpha (default from settings Dynamic.Alpha, else 0.1)");
   cmd->add_flag("--no-depth-step", args->no_depth_step, "Mask step only (no depth-ROI step)");
-  cmd->add_flag("--geometric-check", args->geometric_check,
-                "Also reject movers the segmenter missed by their residual against the tracked pose (settings Dynamic.GeometricCheck)");
+  auto* geo = cmd->add_flag("--geometric-check", args->geometric_check,
+                            "Also reject movers the segmenter missed by their residual against the tracked pose (settings Dynamic.GeometricCheck, default on)");
+  cmd->add_flag("--no-geometric-check", args->no_geometric_check, "Turn the geometric check off")->excludes(geo);
   cmd->add_option("--segment-every", args->segment_every,
                   "Run the segmenter on every K-th frame only; masks follow the optical flow in between (settings Segmentation.EveryK, default 1)")
       ->check(CLI::PositiveNumber);

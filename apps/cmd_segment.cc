@@ -24,11 +24,13 @@ struct SegmentArgs {
   std::string out;
   int64_t max_frames = -1;
   bool no_person_mask = false;
+  std::vector<std::string> overrides;  // --set KEY=VALUE
 };
 
 void Segment(const SegmentArgs& a) {
   const RgbdDataset dataset = RgbdDataset::Open(a.dataset, DatasetOptions());
-  const Settings settings = a.config.empty() ? PresetForDataset(a.dataset) : ReadSettings(a.config);
+  Settings settings = a.config.empty() ? PresetForDataset(a.dataset) : ReadSettings(a.config);
+  ApplySettingOverrides(a.overrides, &settings);
   const std::string models = a.models.empty() ? DefaultModelsDir() : a.models;
   DnnSegmenterOptions options = DnnOptionsFromSettings(settings, models);
   if (!a.detector.empty()) {
@@ -88,6 +90,9 @@ void AddSegmentCommand(CLI::App& app) {
                   "Detector: YOLOX .onnx or Darknet .cfg (weights and names beside it)");
   cmd->add_option("--out", a->out, "Output masks folder")->required();
   cmd->add_option("--max-frames", a->max_frames, "Segment at most this many frames");
+  cmd->add_option("--set", a->overrides,
+                  "Override a settings key, KEY=VALUE (repeatable), e.g. "
+                  "--set Segmentation.SecondDetector=none");
   cmd->add_flag("--no-person-mask", a->no_person_mask,
                 "Skip the person mask model (masks = box pixels at the dominant depth)");
   cmd->callback([a] { Segment(*a); });

@@ -387,4 +387,21 @@ void WriteSettings(const std::string& path, const Settings& settings) {
   });
 }
 
+void ApplySettingOverrides(const std::vector<std::string>& overrides, Settings* settings) {
+  for (const std::string& o : overrides) {
+    const size_t eq = o.find('=');
+    if (eq == std::string::npos || eq == 0 || eq + 1 == o.size()) {
+      throw InputError("--set " + o + ": expected KEY=VALUE, e.g. --set Dynamic.Alpha=0.2");
+    }
+    const std::string key = o.substr(0, eq);
+    for (const char* typed : {"Camera", "Camera1.", "Camera.", "Stereo.", "RGBD.", "ORBextractor."}) {
+      if (key.rfind(typed, 0) == 0) {
+        throw InputError("--set " + o + ": camera and ORB keys come from the settings file (--config)");
+      }
+    }
+    settings->extra[key] = o.substr(eq + 1);
+  }
+  if (!overrides.empty()) settings->source += " + --set overrides";
+}
+
 }  // namespace detslam

@@ -10,6 +10,7 @@
 
 #include <map>
 #include <string>
+#include <vector>
 
 #include "detslam/core/camera.h"
 
@@ -59,5 +60,10 @@ Settings PresetByName(const std::string& name);
 // appears in the folder's name (freiburg1/fr1, freiburg2/fr2, freiburg3/fr3, bonn). Throws
 // InputError if none matches (the user must pass --config FILE).
 Settings PresetForDataset(const std::string& dataset_dir);
+
+// Applies command-line overrides "KEY=VALUE" (`--set`) to the extra keys (Tracking.*,
+// LocalMapping.*, Dynamic.*, Segmentation.*, ...). Throws InputError for a malformed item or a
+// camera/ORB key (those come from the settings file).
+void ApplySettingOverrides(const std::vector<std::string>& overrides, Settings* settings);
 
 }  // namespace detslam

@@ -55,21 +55,28 @@ std::vector<std::string> ReadNames(const std::string& path) {
   return names;
 }
 
+constexpr const char* kDefaultSecondDetector = "yolo_fastest_1.1/yolo-fastest-1.1-xl.cfg";
+
 }  // namespace
 
-struct DnnSegmenter::Nets {
-  cv::dnn::Net net;
-  std::unique_ptr<cv::dnn::DetectionModel> darknet;
-};
+namespace {
+std::string DetectorFormatError(const std::string& path, const char* which) {
+  if (EndsWith(path, ".onnx") || EndsWith(path, ".cfg")) return "";
+  return std::string(which) + " detector must be a YOLOX .onnx or a Darknet .cfg: " + path;
+}
+}  // namespace
 
 bool DnnSegmenterOptions::Check(std::string* error) const {
   std::string e;
   if (detector_path.empty())
     e = "no detector model given";
-  else if (!EndsWith(detector_path, ".onnx") && !EndsWith(detector_path, ".cfg"))
-    e = "detector must be a YOLOX .onnx or a Darknet .cfg: " + detector_path;
-  else if (!(score_threshold > 0 && score_threshold < 1))
+  else if (!(e = DetectorFormatError(detector_path, "first")).empty()) {
+  } else if (!second_detector_path.empty() &&
+             !(e = DetectorFormatError(second_detector_path, "second")).empty()) {
+  } else if (!(score_threshold > 0 && score_threshold < 1))
     e = "score threshold must be in (0, 1)";
+  else if (!(second_score_threshold > 0 && second_score_threshold < 1))
+    e = "second detector score threshold must be in (0, 1)";
   else if (!(nms_threshold > 0 && nms_threshold <= 1))
     e = "NMS threshold must be in (0, 1]";
   else if (!(box_expand >= 0 && box_expand <= 1))
@@ -80,27 +87,48 @@ bool DnnSegmenterOptions::Check(std::string* error) const {
     e = "Darknet input size must be a positive multiple of 32";
   else if (!(person_mask_threshold > 0 && person_mask_threshold < 1))
     e = "person mask threshold must be in (0, 1)";
+  else if (!(person_mask_min_fill >= 0 && person_mask_min_fill < 1))
+    e = "person mask minimum fill must be in [0, 1)";
   if (e.empty()) depth_mask.Check(&e);
   if (!e.empty() && error != nullptr) *error = e;
   return e.empty();
 }
 
-void ResolveModelCompanions(DnnSegmenterOptions* o) {
-  const fs::path det(o->detector_path);
-  const bool darknet = EndsWith(o->detector_path, ".cfg");
-  if (darknet && o->weights_path.empty()) {
-    o->weights_path = fs::path(det).replace_extension(".weights").string();
-  }
-  if (o->names_path.empty()) {
+namespace {
+
+// Darknet weights beside the .cfg; coco.names (body.names for a *_body.cfg) beside the detector.
+void ResolveCompanions(const std::string& detector, std::string* weights, std::string* names) {
+  if (detector.empty()) return;
+  const fs::path det(detector);
+  const bool darknet = EndsWith(detector, ".cfg");
+  if (darknet && weights->empty()) *weights = fs::path(det).replace_extension(".weights").string();
+  if (names->empty()) {
     const bool body = darknet && EndsWith(det.stem().string(), "_body");
-    o->names_path = (det.parent_path() / (body ? "body.names" : "coco.names")).string();
+    *names = (det.parent_path() / (body ? "body.names" : "coco.names")).string();
   }
 }
 
+void AppendModelFiles(const std::string& detector, const std::string& weights,
+                      const std::string& names, std::vector<std::string>* paths) {
+  paths->push_back(detector);
+  if (EndsWith(detector, ".cfg")) paths->push_back(weights);
+  paths->push_back(names);
+}
+
+}  // namespace
+
+void ResolveModelCompanions(DnnSegmenterOptions* o) {
+  ResolveCompanions(o->detector_path, &o->weights_path, &o->names_path);
+  ResolveCompanions(o->second_detector_path, &o->second_weights_path, &o->second_names_path);
+}
+
 std::vector<std::string> LookedForModels(const DnnSegmenterOptions& options) {
-  std::vector<std::string> paths = {options.detector_path};
-  if (EndsWith(options.detector_path, ".cfg")) paths.push_back(options.weights_path);
-  paths.push_back(options.names_path);
+  std::vector<std::string> paths;
+  AppendModelFiles(options.detector_path, options.weights_path, options.names_path, &paths);
+  if (!options.second_detector_path.empty()) {
+    AppendModelFiles(options.second_detector_path, options.second_weights_path,
+                     options.second_names_path, &paths);
+  }
   if (!options.person_mask_model.empty()) paths.push_back(options.person_mask_model);
   return paths;
 }
@@ -128,6 +156,25 @@ DnnSegmenterOptions DnnOptionsFromSettings(const Settings& s, const std::string&
   o.nms_threshold = static_cast<float>(s.GetDouble("Segmentation.NmsThreshold", o.nms_threshold));
   o.box_expand = s.GetDouble("Segmentation.BoxExpand", o.box_expand);
   o.yolox_input_size = s.GetInt("Segmentation.InputSize", o.yolox_input_size);
+  o.person_mask_min_fill = static_cast<float>(
+      s.GetDouble("Segmentation.PersonMaskMinFill", o.person_mask_min_fill));
+  // The default second detector is optional: without its files the first one works alone. A
+  // second detector named in the settings must exist.
+  const std::string second = s.GetString("Segmentation.SecondDetector", "");
+  if (second.empty()) {
+    const std::string fallback = resolve(kDefaultSecondDetector);
+    if (fs::is_regular_file(fallback)) {
+      o.second_detector_path = fallback;
+    } else {
+      spdlog::warn("second detector {} not found; using the first detector alone", fallback);
+    }
+  } else if (second != "none") {
+    o.second_detector_path = resolve(second);
+  }
+  o.second_weights_path = resolve(s.GetString("Segmentation.SecondWeights", ""));
+  o.second_names_path = resolve(s.GetString("Segmentation.SecondNames", ""));
+  o.second_score_threshold = static_cast<float>(
+      s.GetDouble("Segmentation.SecondScoreThreshold", o.second_score_threshold));
   std::stringstream classes(s.GetString("Segmentation.DynamicClasses", ""));
   std::string item;
   while (std::getline(classes, item, ',')) {
@@ -137,8 +184,102 @@ DnnSegmenterOptions DnnOptionsFromSettings(const Settings& s, const std::string&
   return o;
 }
 
-DnnSegmenter::DnnSegmenter(const DnnSegmenterOptions& options)
-    : options_(options), nets_(std::make_unique<Nets>()) {
+// One detection network: YOLOX (.onnx) or Darknet (.cfg + .weights) with its class names.
+class DnnSegmenter::Detector {
+ public:
+  Detector(const std::string& path, const std::string& weights, const std::string& names_path,
+           float score_threshold, const DnnSegmenterOptions& o)
+      : path_(path),
+        darknet_(EndsWith(path, ".cfg")),
+        names_(ReadNames(names_path)),
+        score_threshold_(score_threshold),
+        nms_threshold_(o.nms_threshold),
+        yolox_side_(o.yolox_input_size) {
+    try {
+      net_ = darknet_ ? cv::dnn::readNetFromDarknet(path, weights) : cv::dnn::readNetFromONNX(path);
+    } catch (const cv::Exception& e) {
+      throw InputError(path, 0, std::string("cannot load detector: ") + e.what());
+    }
+    if (net_.empty()) throw InputError(path, 0, "cannot load detector");
+    net_.setPreferableBackend(cv::dnn::DNN_BACKEND_OPENCV);
+    net_.setPreferableTarget(cv::dnn::DNN_TARGET_CPU);
+    if (darknet_) {
+      darknet_model_ = std::make_unique<cv::dnn::DetectionModel>(net_);
+      const int side = o.darknet_input_size;
+      darknet_model_->setInputParams(1.0 / 255.0, cv::Size(side, side), cv::Scalar(),
+                                     /*swapRB=*/true);
+      darknet_model_->setNmsAcrossClasses(false);
+    }
+  }
+
+  const std::vector<std::string>& names() const { return names_; }
+
+  // Detections sorted by descending score, class ids mapped to names.
+  std::vector<Detection> Detect(const cv::Mat& bgr) {
+    std::vector<std::pair<int, Detection>> raw = darknet_ ? DetectDarknet(bgr) : DetectYolox(bgr);
+    std::vector<Detection> out;
+    for (auto& [class_id, d] : raw) {
+      if (class_id < 0 || class_id >= static_cast<int>(names_.size())) continue;
+      d.class_name = names_[class_id] == "body" ? "person" : names_[class_id];
+      d.class_id = class_id;
+      out.push_back(std::move(d));
+    }
+    std::stable_sort(out.begin(), out.end(),
+                     [](const Detection& a, const Detection& b) { return a.score > b.score; });
+    return out;
+  }
+
+ private:
+  std::vector<std::pair<int, Detection>> DetectYolox(const cv::Mat& bgr) {
+    double scale = 1.0;
+    const cv::Mat boxed = LetterboxTopLeft(bgr, yolox_side_, &scale);
+    // NCHW float blob, BGR 0..255, no normalisation.
+    cv::Mat blob =
+        cv::dnn::blobFromImage(boxed, 1.0, cv::Size(), cv::Scalar(), false, false, CV_32F);
+    net_.setInput(blob);
+    cv::Mat out = net_.forward();
+    const int rows = YoloxOutputRows(yolox_side_);
+    if (rows == 0 || out.total() % rows != 0 || out.total() / rows != 5 + names_.size()) {
+      std::ostringstream os;
+      os << "YOLOX output has " << out.total() << " values; expected " << rows << " x "
+         << 5 + names_.size() << " for input size " << yolox_side_ << " and " << names_.size()
+         << " classes (set Segmentation.InputSize / Segmentation.Names)";
+      throw InputError(path_, 0, os.str());
+    }
+    const auto raw = DecodeYolox(out.ptr<float>(), rows, static_cast<int>(5 + names_.size()),
+                                 yolox_side_, scale, score_threshold_);
+    std::vector<std::pair<int, Detection>> dets;
+    for (const RawDetection& d : NmsPerClass(raw, score_threshold_, nms_threshold_)) {
+      const cv::Rect box(
+          cv::Point(static_cast<int>(std::floor(d.box.x)), static_cast<int>(std::floor(d.box.y))),
+          cv::Point(static_cast<int>(std::ceil(d.box.br().x)),
+                    static_cast<int>(std::ceil(d.box.br().y))));
+      dets.push_back({d.class_id, Detection{"", d.class_id, d.score, box}});
+    }
+    return dets;
+  }
+
+  std::vector<std::pair<int, Detection>> DetectDarknet(const cv::Mat& bgr) {
+    std::vector<int> ids;
+    std::vector<float> scores;
+    std::vector<cv::Rect> boxes;
+    darknet_model_->detect(bgr, ids, scores, boxes, score_threshold_, nms_threshold_);
+    std::vector<std::pair<int, Detection>> dets;
+    for (size_t i = 0; i < ids.size(); ++i) dets.push_back({ids[i], Detection{"", ids[i], scores[i], boxes[i]}});
+    return dets;
+  }
+
+  std::string path_;
+  bool darknet_;
+  std::vector<std::string> names_;
+  float score_threshold_;
+  float nms_threshold_;
+  int yolox_side_;
+  cv::dnn::Net net_;
+  std::unique_ptr<cv::dnn::DetectionModel> darknet_model_;
+};
+
+DnnSegmenter::DnnSegmenter(const DnnSegmenterOptions& options) : options_(options) {
   ResolveModelCompanions(&options_);
   std::string error;
   if (!options_.Check(&error)) throw InputError("segmentation options: " + error);
@@ -154,75 +295,30 @@ DnnSegmenter::DnnSegmenter(const DnnSegmenterOptions& options)
                          "\nPut the models there, set $DETSLAM_MODELS or pass --models DIR "
                          "(see models/README.md)");
   }
-  darknet_ = EndsWith(options_.detector_path, ".cfg");
-  names_ = ReadNames(options_.names_path);
-  try {
-    if (darknet_) {
-      nets_->net = cv::dnn::readNetFromDarknet(options_.detector_path, options_.weights_path);
-    } else {
-      nets_->net = cv::dnn::readNetFromONNX(options_.detector_path);
-    }
-  } catch (const cv::Exception& e) {
-    throw InputError(options_.detector_path, 0, std::string("cannot load detector: ") + e.what());
+  const DnnSegmenterOptions& o = options_;
+  first_ = std::make_unique<Detector>(o.detector_path, o.weights_path, o.names_path,
+                                      o.score_threshold, o);
+  if (!o.second_detector_path.empty()) {
+    second_ = std::make_unique<Detector>(o.second_detector_path, o.second_weights_path,
+                                         o.second_names_path, o.second_score_threshold, o);
   }
-  if (nets_->net.empty()) throw InputError(options_.detector_path, 0, "cannot load detector");
-  nets_->net.setPreferableBackend(cv::dnn::DNN_BACKEND_OPENCV);
-  nets_->net.setPreferableTarget(cv::dnn::DNN_TARGET_CPU);
-  if (darknet_) {
-    nets_->darknet = std::make_unique<cv::dnn::DetectionModel>(nets_->net);
-    const int s = options_.darknet_input_size;
-    nets_->darknet->setInputParams(1.0 / 255.0, cv::Size(s, s), cv::Scalar(), /*swapRB=*/true);
-    nets_->darknet->setNmsAcrossClasses(false);
+  if (!o.person_mask_model.empty()) {
+    person_mask_ = std::make_unique<PersonMaskModel>(o.person_mask_model);
   }
-  if (!options_.person_mask_model.empty()) {
-    person_mask_ = std::make_unique<PersonMaskModel>(options_.person_mask_model);
-  }
-  name_ = "dnn:" + fs::path(options_.detector_path).filename().string() +
-          (person_mask_ ? "+" + fs::path(options_.person_mask_model).filename().string() : "");
-  spdlog::debug("segmenter {} with {} classes", name_, names_.size());
+  name_ = "dnn:" + fs::path(o.detector_path).filename().string() +
+          (second_ ? "+" + fs::path(o.second_detector_path).filename().string() : "") +
+          (person_mask_ ? "+" + fs::path(o.person_mask_model).filename().string() : "");
+  spdlog::debug("segmenter {} with {} classes", name_, first_->names().size());
 }
 
 DnnSegmenter::~DnnSegmenter() = default;
 
-std::vector<DnnSegmenter::Detection> DnnSegmenter::DetectYolox(const cv::Mat& bgr) {
-  const int side = options_.yolox_input_size;
-  double scale = 1.0;
-  const cv::Mat boxed = LetterboxTopLeft(bgr, side, &scale);
-  // NCHW float blob, BGR 0..255, no normalisation.
-  cv::Mat blob = cv::dnn::blobFromImage(boxed, 1.0, cv::Size(), cv::Scalar(), false, false, CV_32F);
-  nets_->net.setInput(blob);
-  cv::Mat out = nets_->net.forward();
-  const int rows = YoloxOutputRows(side);
-  if (rows == 0 || out.total() % rows != 0 || out.total() / rows != 5 + names_.size()) {
-    std::ostringstream os;
-    os << "YOLOX output has " << out.total() << " values; expected " << rows << " x "
-       << 5 + names_.size() << " for input size " << side << " and " << names_.size()
-       << " classes (set Segmentation.InputSize / Segmentation.Names)";
-    throw InputError(options_.detector_path, 0, os.str());
-  }
-  const auto raw = DecodeYolox(out.ptr<float>(), rows, static_cast<int>(5 + names_.size()), side,
-                               scale, options_.score_threshold);
-  std::vector<Detection> dets;
-  for (const RawDetection& d : NmsPerClass(raw, options_.score_threshold, options_.nms_threshold)) {
-    const cv::Rect box(
-        cv::Point(static_cast<int>(std::floor(d.box.x)), static_cast<int>(std::floor(d.box.y))),
-        cv::Point(static_cast<int>(std::ceil(d.box.br().x)),
-                  static_cast<int>(std::ceil(d.box.br().y))));
-    dets.push_back({d.class_id, d.score, box});
-  }
-  return dets;
-}
+const std::vector<std::string>& DnnSegmenter::class_names() const { return first_->names(); }
 
-std::vector<DnnSegmenter::Detection> DnnSegmenter::DetectDarknet(const cv::Mat& bgr) {
-  std::vector<int> ids;
-  std::vector<float> scores;
-  std::vector<cv::Rect> boxes;
-  nets_->darknet->detect(bgr, ids, scores, boxes, options_.score_threshold, options_.nms_threshold);
-  std::vector<Detection> dets;
-  for (size_t i = 0; i < ids.size(); ++i) dets.push_back({ids[i], scores[i], boxes[i]});
-  std::stable_sort(dets.begin(), dets.end(),
-                   [](const Detection& a, const Detection& b) { return a.score > b.score; });
-  return dets;
+bool DnnSegmenter::Wanted(const std::string& class_name) const {
+  return options_.classes.empty() ||
+         std::find(options_.classes.begin(), options_.classes.end(), class_name) !=
+             options_.classes.end();
 }
 
 std::vector<Instance> DnnSegmenter::Segment(const SegmenterInput& input) {
@@ -232,25 +328,45 @@ std::vector<Instance> DnnSegmenter::Segment(const SegmenterInput& input) {
   const cv::Size size = input.bgr.size();
   const cv::Rect image(0, 0, size.width, size.height);
   auto t0 = Clock::now();
-  const std::vector<Detection> dets = darknet_ ? DetectDarknet(input.bgr) : DetectYolox(input.bgr);
+  std::vector<Detection> dets;
+  for (Detection& d : first_->Detect(input.bgr)) {
+    d.box &= image;
+    if (!d.box.empty() && Wanted(d.class_name)) dets.push_back(std::move(d));
+  }
+  timings_.second_added = 0;
+  if (second_) {
+    const size_t from_first = dets.size();
+    for (Detection& d : second_->Detect(input.bgr)) {
+      d.box &= image;
+      if (d.box.empty() || !Wanted(d.class_name)) continue;
+      // Kept only where no same-class box (of the first detector, or one already added) covers
+      // half of it.
+      bool covered = false;
+      for (const Detection& k : dets) {
+        if (k.class_name == d.class_name && (k.box & d.box).area() * 2 > d.box.area()) covered = true;
+      }
+      if (!covered) dets.push_back(std::move(d));
+    }
+    timings_.second_added = static_cast<int>(dets.size() - from_first);
+  }
   timings_.detect_ms = MsSince(t0);
   t0 = Clock::now();
   std::vector<Instance> out;
   for (const Detection& d : dets) {
     Instance in;
-    in.box = d.box & image;
-    if (in.box.empty() || d.class_id < 0 || d.class_id >= static_cast<int>(names_.size())) continue;
-    in.class_name = names_[d.class_id] == "body" ? "person" : names_[d.class_id];
+    in.box = d.box;
+    in.class_name = d.class_name;
     const int coco = CocoClassId(in.class_name);
     in.class_id = coco >= 0 ? coco : d.class_id;
     in.score = d.score;
-    if (!options_.classes.empty() && std::find(options_.classes.begin(), options_.classes.end(),
-                                               in.class_name) == options_.classes.end()) {
-      continue;
-    }
     if (in.class_id == 0 && person_mask_) {
       const cv::Rect crop = ExpandBox(in.box, options_.box_expand, size);
       in.mask = person_mask_->Mask(input.bgr, crop, options_.person_mask_threshold);
+      const double fill =
+          static_cast<double>(cv::countNonZero(in.mask(in.box))) / std::max(1, in.box.area());
+      if (fill < options_.person_mask_min_fill) {
+        in.mask = DominantDepthBoxMask(input.depth_m, in.box, size, options_.depth_mask);
+      }
     } else {
       in.mask = DominantDepthBoxMask(input.depth_m, in.box, size, options_.depth_mask);
     }

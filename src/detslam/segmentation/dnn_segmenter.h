@@ -1,7 +1,10 @@
 // The OpenCV-dnn (CPU) segmenter: a COCO detector (YOLOX ONNX, or Yolo-Fastest Darknet cfg +
-// weights) finds boxes; person boxes get a MediaPipe Selfie Segmentation mask computed on the box
-// expanded by `box_expand`; other classes get the box pixels at the object's dominant depth
-// (box_mask.h). Models: ../shared/models/README.md (or $DETSLAM_MODELS).
+// weights) finds boxes; an optional second detector adds the boxes the first one missed (a box of
+// the second is kept when no box of the same class from the first covers half of it); person
+// boxes get a MediaPipe Selfie Segmentation mask computed on the box expanded by `box_expand`,
+// replaced by the depth mask below when it fills less than `person_mask_min_fill` of the box (the
+// portrait model misses close-up bodies without a face); other classes get the box pixels at the
+// object's dominant depth (box_mask.h). Models: ../shared/models/README.md (or $DETSLAM_MODELS).
 #pragma once
 
 #include <memory>
@@ -29,6 +32,13 @@ struct DnnSegmenterOptions {
   int yolox_input_size = 416;        // square input of the YOLOX export (multiple of 32)
   int darknet_input_size = 320;      // square input of the Darknet model
   float person_mask_threshold = 0.5f;  // selfie probability above which a pixel is person
+  float person_mask_min_fill = 0.25f;  // selfie mask covering less of the box -> depth mask
+  // Optional second detector (same formats as the first; empty = none). Its boxes are added where
+  // the first detector found nothing of that class.
+  std::string second_detector_path;
+  std::string second_weights_path;
+  std::string second_names_path;
+  float second_score_threshold = 0.15f;
   DominantDepthOptions depth_mask;     // masks of classes without a mask model
 
   bool Check(std::string* error) const;
@@ -52,6 +62,10 @@ std::string DefaultModelsDir();
 //                                ("none" = box masks only)
 //   Segmentation.ScoreThreshold  Segmentation.NmsThreshold  Segmentation.BoxExpand
 //   Segmentation.InputSize       YOLOX input side (default 416)
+//   Segmentation.PersonMaskMinFill  selfie mask fill of the box below which the depth mask is used
+//   Segmentation.SecondDetector  default <models_dir>/yolo_fastest_1.1/yolo-fastest-1.1-xl.cfg
+//                                ("none" = one detector); Segmentation.SecondWeights,
+//                                Segmentation.SecondNames, Segmentation.SecondScoreThreshold
 //   Segmentation.DynamicClasses  comma-separated class names to return (default: all)
 DnnSegmenterOptions DnnOptionsFromSettings(const Settings& settings, const std::string& models_dir);
 
@@ -59,6 +73,7 @@ DnnSegmenterOptions DnnOptionsFromSettings(const Settings& settings, const std::
 struct DnnTimings {
   double detect_ms = 0;  // preprocessing + network + decoding + NMS
   double mask_ms = 0;    // person masks and depth masks of all instances
+  int second_added = 0;  // boxes added by the second detector
 };
 
 class DnnSegmenter : public Segmenter {
@@ -71,23 +86,23 @@ class DnnSegmenter : public Segmenter {
   std::vector<Instance> Segment(const SegmenterInput& input) override;
   std::string name() const override { return name_; }
   const DnnTimings& last_timings() const { return timings_; }
-  const std::vector<std::string>& class_names() const { return names_; }
+  // Class names of the first detector.
+  const std::vector<std::string>& class_names() const;
 
  private:
   struct Detection {
-    int class_id;
+    std::string class_name;  // "body" (person-only models) reported as "person"
+    int class_id;            // index in the detector's names file
     float score;
     cv::Rect box;
   };
-  std::vector<Detection> DetectYolox(const cv::Mat& bgr);
-  std::vector<Detection> DetectDarknet(const cv::Mat& bgr);
+  class Detector;
+  bool Wanted(const std::string& class_name) const;
 
   DnnSegmenterOptions options_;
   std::string name_;
-  bool darknet_ = false;
-  std::vector<std::string> names_;
-  struct Nets;
-  std::unique_ptr<Nets> nets_;
+  std::unique_ptr<Detector> first_;
+  std::unique_ptr<Detector> second_;
   std::unique_ptr<PersonMaskModel> person_mask_;
   DnnTimings timings_;
 };

@@ -36,8 +36,10 @@ struct TrackerOptions {
   int close_tracked_max = 100;         // bNeedToInsertClose: tracked close < this
   int close_untracked_min = 70;        //                      and untracked close > this
   uint64_t seed = 42;                  // relocalisation RANSAC
-  // Geometric check for movers the segmenter missed (see tracker_geometric.cc).
-  bool geometric_check = false;
+  // Geometric check for movers the segmenter missed (see tracker_geometric.cc). On by default: it
+  // lowered the error on the walking presets where the detector misses partly visible people and
+  // changed nothing on the static benchmarks (docs/BENCHMARKS.md).
+  bool geometric_check = true;
   GeometricCheckOptions geometric;     // robust threshold on reprojection residuals (pixels / scale)
   double geometric_radius_px = 30.0;   // cluster / spread radius around a flagged keypoint
   double geometric_depth_ratio = 0.1;  // same object: depths within this fraction
