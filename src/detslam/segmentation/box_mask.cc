@@ -108,4 +108,13 @@ double BoxIou(const cv::Rect& a, const cv::Rect& b) {
   return uni > 0 ? inter / uni : 0.0;
 }
 
+cv::Mat PersonMaskOrDepth(const cv::Mat& model_mask, const cv::Rect& box, double min_fill,
+                          const cv::Mat& depth_m, const DominantDepthOptions& options) {
+  const cv::Rect b = box & cv::Rect(0, 0, model_mask.cols, model_mask.rows);
+  const double fill =
+      b.empty() ? 0.0 : static_cast<double>(cv::countNonZero(model_mask(b))) / b.area();
+  if (!b.empty() && fill >= min_fill) return model_mask;
+  return DominantDepthBoxMask(depth_m, box, model_mask.size(), options);
+}
+
 }  // namespace detslam

@@ -30,6 +30,12 @@ cv::Rect ExpandBox(const cv::Rect& box, double fraction, const cv::Size& size);
 cv::Mat DominantDepthBoxMask(const cv::Mat& depth_m, const cv::Rect& box, const cv::Size& size,
                              const DominantDepthOptions& options);
 
+// The mask of a person: `model_mask` (full-image CV_8UC1 from a person mask model) when it covers
+// at least `min_fill` of `box`, else DominantDepthBoxMask (the model failed on this crop, e.g. a
+// portrait model on a close-up torso without a face).
+cv::Mat PersonMaskOrDepth(const cv::Mat& model_mask, const cv::Rect& box, double min_fill,
+                          const cv::Mat& depth_m, const DominantDepthOptions& options);
+
 // Intersection over union of two binary masks (non-zero = set); 0 if both are empty.
 double MaskIou(const cv::Mat& a, const cv::Mat& b);
 

@@ -83,6 +83,25 @@ TEST(BoxMask, OptionsCheck) {
   EXPECT_NE(error.find("bin"), std::string::npos);
 }
 
+TEST(BoxMask, PersonMaskFallsBackToDepthWhenTheModelMaskIsTooSmall) {
+  Scene s;
+  const cv::Rect box(20, 15, 40, 70);  // 2800 px
+  const cv::Mat depth_mask = DominantDepthBoxMask(s.depth, box, s.depth.size(), DominantDepthOptions());
+  // A model mask covering 30x40 = 1200 px (43 % of the box) is kept as it is.
+  cv::Mat model(s.depth.size(), CV_8UC1, cv::Scalar(0));
+  model(cv::Rect(25, 30, 30, 40)).setTo(255);
+  cv::Mat kept = PersonMaskOrDepth(model, box, 0.25, s.depth, DominantDepthOptions());
+  EXPECT_EQ(cv::countNonZero(kept != model), 0);
+  // A model mask covering 10x10 = 100 px (4 %) gives way to the dominant-depth mask.
+  model.setTo(0);
+  model(cv::Rect(30, 30, 10, 10)).setTo(255);
+  cv::Mat replaced = PersonMaskOrDepth(model, box, 0.25, s.depth, DominantDepthOptions());
+  EXPECT_EQ(cv::countNonZero(replaced != depth_mask), 0);
+  // min_fill 0 keeps even an empty model mask.
+  model.setTo(0);
+  EXPECT_EQ(cv::countNonZero(PersonMaskOrDepth(model, box, 0.0, s.depth, DominantDepthOptions())), 0);
+}
+
 TEST(BoxMask, IouOfMasksAndBoxes) {
   cv::Mat a(10, 10, CV_8UC1, cv::Scalar(0)), b = a.clone();
   a(cv::Rect(0, 0, 4, 5)).setTo(1);

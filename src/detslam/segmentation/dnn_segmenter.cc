@@ -361,12 +361,9 @@ std::vector<Instance> DnnSegmenter::Segment(const SegmenterInput& input) {
     in.score = d.score;
     if (in.class_id == 0 && person_mask_) {
       const cv::Rect crop = ExpandBox(in.box, options_.box_expand, size);
-      in.mask = person_mask_->Mask(input.bgr, crop, options_.person_mask_threshold);
-      const double fill =
-          static_cast<double>(cv::countNonZero(in.mask(in.box))) / std::max(1, in.box.area());
-      if (fill < options_.person_mask_min_fill) {
-        in.mask = DominantDepthBoxMask(input.depth_m, in.box, size, options_.depth_mask);
-      }
+      in.mask = PersonMaskOrDepth(
+          person_mask_->Mask(input.bgr, crop, options_.person_mask_threshold), in.box,
+          options_.person_mask_min_fill, input.depth_m, options_.depth_mask);
     } else {
       in.mask = DominantDepthBoxMask(input.depth_m, in.box, size, options_.depth_mask);
     }

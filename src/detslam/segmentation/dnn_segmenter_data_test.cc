@@ -133,5 +133,32 @@ TEST(DataDnnSegmenter, YoloFastestXlFindsBothPeople) {
   ExpectBothPeopleBoxes("models/yolo_fastest_1.1/yolo-fastest-1.1-xl.cfg", "yolo_fastest_xl");
 }
 
+TEST(DataDnnSegmenter, SecondDetectorAddsOnlyWhatTheFirstMissed) {
+  DETSLAM_REQUIRE_SHARED("models/yolox_nano/yolox_nano.onnx");
+  DETSLAM_REQUIRE_SHARED("models/yolo_fastest_1.1/yolo-fastest-1.1-xl.weights");
+  DETSLAM_REQUIRE_SHARED(kReference);
+  const ClipFrame f = LoadClip();
+  DnnSegmenterOptions o;
+  o.detector_path = SharedPath("models/yolox_nano/yolox_nano.onnx");
+  o.second_detector_path = SharedPath("models/yolo_fastest_1.1/yolo-fastest-1.1-xl.cfg");
+  o.classes = {"person"};
+  // Both detectors find both people: the second one adds no duplicate.
+  DnnSegmenter both(o);
+  EXPECT_EQ(People(both.Segment(f.input)).size(), 2u);
+  EXPECT_EQ(both.last_timings().second_added, 0);
+  // A first detector that finds nothing (threshold 0.99): the second one supplies both people.
+  o.score_threshold = 0.99f;
+  DnnSegmenter blind_first(o);
+  const auto people = People(blind_first.Segment(f.input));
+  EXPECT_EQ(blind_first.last_timings().second_added, static_cast<int>(people.size()));
+  ASSERT_EQ(people.size(), 2u);
+  for (int id = 1; id <= 2; ++id) {
+    const cv::Rect ref_box = cv::boundingRect(f.reference == id);
+    double best = 0;
+    for (const Instance& p : people) best = std::max(best, BoxIou(p.box, ref_box));
+    EXPECT_GE(best, 0.5) << "reference person " << id << " at " << ref_box;
+  }
+}
+
 }  // namespace
 }  // namespace detslam

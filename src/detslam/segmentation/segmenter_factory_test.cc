@@ -87,6 +87,37 @@ TEST(DnnOptions, FromSettingsResolvesCompanionsAndClasses) {
   EXPECT_TRUE(d.Check(&error)) << error;
 }
 
+TEST(DnnOptions, SecondDetectorDefaultIsOptionalAndExplicitOneIsKept) {
+  // Default: the second detector is used only where its file exists in the models folder.
+  Settings none_set;
+  none_set.extra["Segmentation.Detector"] = "yolox_nano/yolox_nano.onnx";
+  EXPECT_TRUE(DnnOptionsFromSettings(none_set, "/no/such/models").second_detector_path.empty());
+  const std::string dir = ::testing::TempDir() + "/detslam_second_detector";
+  std::filesystem::create_directories(dir + "/yolo_fastest_1.1");
+  std::ofstream(dir + "/yolo_fastest_1.1/yolo-fastest-1.1-xl.cfg") << "[net]\n";
+  const DnnSegmenterOptions d = DnnOptionsFromSettings(Settings(), dir);
+  EXPECT_EQ(d.second_detector_path, dir + "/yolo_fastest_1.1/yolo-fastest-1.1-xl.cfg");
+  EXPECT_EQ(d.second_weights_path, dir + "/yolo_fastest_1.1/yolo-fastest-1.1-xl.weights");
+  EXPECT_EQ(d.second_names_path, dir + "/yolo_fastest_1.1/coco.names");
+  EXPECT_FLOAT_EQ(d.second_score_threshold, 0.15f);
+  const auto looked = LookedForModels(d);
+  EXPECT_NE(std::find(looked.begin(), looked.end(), d.second_weights_path), looked.end());
+  EXPECT_NE(std::find(looked.begin(), looked.end(), d.second_names_path), looked.end());
+  // "none" turns it off even where the file exists; a named one is kept even when missing (the
+  // segmenter then reports it as missing).
+  Settings off;
+  off.extra["Segmentation.SecondDetector"] = "none";
+  EXPECT_TRUE(DnnOptionsFromSettings(off, dir).second_detector_path.empty());
+  Settings named;
+  named.extra["Segmentation.SecondDetector"] = "other/body.cfg";
+  named.extra["Segmentation.SecondScoreThreshold"] = "0.3";
+  const DnnSegmenterOptions n = DnnOptionsFromSettings(named, "/m");
+  EXPECT_EQ(n.second_detector_path, "/m/other/body.cfg");
+  EXPECT_EQ(n.second_weights_path, "/m/other/body.weights");
+  EXPECT_FLOAT_EQ(n.second_score_threshold, 0.3f);
+  std::filesystem::remove_all(dir);
+}
+
 TEST(DnnOptions, CheckRejectsBadValues) {
   DnnSegmenterOptions o;
   o.detector_path = "x.onnx";
@@ -101,6 +132,17 @@ TEST(DnnOptions, CheckRejectsBadValues) {
   o.yolox_input_size = 400;
   EXPECT_FALSE(o.Check(&error));
   EXPECT_NE(error.find("32"), std::string::npos);
+  o.yolox_input_size = 416;
+  o.second_detector_path = "second.pb";
+  EXPECT_FALSE(o.Check(&error));
+  EXPECT_NE(error.find("second"), std::string::npos) << error;
+  o.second_detector_path = "second.cfg";
+  EXPECT_TRUE(o.Check(&error)) << error;
+  o.second_score_threshold = 0.0f;
+  EXPECT_FALSE(o.Check(&error));
+  o.second_score_threshold = 0.15f;
+  o.person_mask_min_fill = 1.0f;
+  EXPECT_FALSE(o.Check(&error));
 }
 
 TEST(DnnOptions, DefaultModelsDirHonoursEnvironment) {
