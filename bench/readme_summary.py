@@ -88,7 +88,12 @@ def summary(bench_text):
                          f"without filter {min(none):.1f}-{max(none):.1f} mm"))
         ks = next((t for t in tables(dyn) if t and "k" in t[0] and "fps (threaded, live dnn)" in t[0]), [])
         for r in ks:
-            rows.append((f"Live threaded pipeline, YOLOX-nano, segment every {r['k']} frame(s)",
+            k = r["k"]
+            if k.isdigit():
+                what = f"dnn segmenter (YOLOX-nano + Yolo-Fastest-xl), segment every {k} frame(s)"
+            else:  # e.g. "1 (YOLOX only)"
+                what = f"YOLOX-nano alone, segment every {k.split()[0]} frame(s)"
+            rows.append((f"Live threaded pipeline, {what}",
                          f"{r['fps (threaded, live dnn)']} fps", f"ATE {r['ATE mm (tracked)']} mm (walking_xyz seed 1)"))
     lines = ["| benchmark | frames | accuracy |", "|---|---|---|"]
     lines += [f"| {a} | {b} | {c} |" for a, b, c in rows]
