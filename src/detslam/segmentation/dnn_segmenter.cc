@@ -57,22 +57,25 @@ std::vector<std::string> ReadNames(const std::string& path) {
 
 constexpr const char* kDefaultSecondDetector = "yolo_fastest_1.1/yolo-fastest-1.1-xl.cfg";
 
-}  // namespace
-
-namespace {
 std::string DetectorFormatError(const std::string& path, const char* which) {
   if (EndsWith(path, ".onnx") || EndsWith(path, ".cfg")) return "";
   return std::string(which) + " detector must be a YOLOX .onnx or a Darknet .cfg: " + path;
 }
+
 }  // namespace
 
 bool DnnSegmenterOptions::Check(std::string* error) const {
   std::string e;
-  if (detector_path.empty())
+  if (detector_path.empty()) {
     e = "no detector model given";
-  else if (!(e = DetectorFormatError(detector_path, "first")).empty()) {
-  } else if (!second_detector_path.empty() &&
-             !(e = DetectorFormatError(second_detector_path, "second")).empty()) {
+  } else {
+    e = DetectorFormatError(detector_path, "first");
+    if (e.empty() && !second_detector_path.empty()) {
+      e = DetectorFormatError(second_detector_path, "second");
+    }
+  }
+  if (!e.empty()) {
+    // reported below
   } else if (!(score_threshold > 0 && score_threshold < 1))
     e = "score threshold must be in (0, 1)";
   else if (!(second_score_threshold > 0 && second_score_threshold < 1))
@@ -216,12 +219,10 @@ class DnnSegmenter::Detector {
 
   // Detections sorted by descending score, class ids mapped to names.
   std::vector<Detection> Detect(const cv::Mat& bgr) {
-    std::vector<std::pair<int, Detection>> raw = darknet_ ? DetectDarknet(bgr) : DetectYolox(bgr);
     std::vector<Detection> out;
-    for (auto& [class_id, d] : raw) {
-      if (class_id < 0 || class_id >= static_cast<int>(names_.size())) continue;
-      d.class_name = names_[class_id] == "body" ? "person" : names_[class_id];
-      d.class_id = class_id;
+    for (Detection& d : darknet_ ? DetectDarknet(bgr) : DetectYolox(bgr)) {
+      if (d.class_id < 0 || d.class_id >= static_cast<int>(names_.size())) continue;
+      d.class_name = names_[d.class_id] == "body" ? "person" : names_[d.class_id];
       out.push_back(std::move(d));
     }
     std::stable_sort(out.begin(), out.end(),
@@ -230,7 +231,7 @@ class DnnSegmenter::Detector {
   }
 
  private:
-  std::vector<std::pair<int, Detection>> DetectYolox(const cv::Mat& bgr) {
+  std::vector<Detection> DetectYolox(const cv::Mat& bgr) {
     double scale = 1.0;
     const cv::Mat boxed = LetterboxTopLeft(bgr, yolox_side_, &scale);
     // NCHW float blob, BGR 0..255, no normalisation.
@@ -248,24 +249,24 @@ class DnnSegmenter::Detector {
     }
     const auto raw = DecodeYolox(out.ptr<float>(), rows, static_cast<int>(5 + names_.size()),
                                  yolox_side_, scale, score_threshold_);
-    std::vector<std::pair<int, Detection>> dets;
+    std::vector<Detection> dets;
     for (const RawDetection& d : NmsPerClass(raw, score_threshold_, nms_threshold_)) {
       const cv::Rect box(
           cv::Point(static_cast<int>(std::floor(d.box.x)), static_cast<int>(std::floor(d.box.y))),
           cv::Point(static_cast<int>(std::ceil(d.box.br().x)),
                     static_cast<int>(std::ceil(d.box.br().y))));
-      dets.push_back({d.class_id, Detection{"", d.class_id, d.score, box}});
+      dets.push_back(Detection{"", d.class_id, d.score, box});
     }
     return dets;
   }
 
-  std::vector<std::pair<int, Detection>> DetectDarknet(const cv::Mat& bgr) {
+  std::vector<Detection> DetectDarknet(const cv::Mat& bgr) {
     std::vector<int> ids;
     std::vector<float> scores;
     std::vector<cv::Rect> boxes;
     darknet_model_->detect(bgr, ids, scores, boxes, score_threshold_, nms_threshold_);
-    std::vector<std::pair<int, Detection>> dets;
-    for (size_t i = 0; i < ids.size(); ++i) dets.push_back({ids[i], Detection{"", ids[i], scores[i], boxes[i]}});
+    std::vector<Detection> dets;
+    for (size_t i = 0; i < ids.size(); ++i) dets.push_back(Detection{"", ids[i], scores[i], boxes[i]});
     return dets;
   }
 
@@ -328,27 +329,23 @@ std::vector<Instance> DnnSegmenter::Segment(const SegmenterInput& input) {
   const cv::Size size = input.bgr.size();
   const cv::Rect image(0, 0, size.width, size.height);
   auto t0 = Clock::now();
+  // Boxes clipped to the image, of the wanted classes; a box of the second detector only where
+  // no same-class box (of the first detector, or one already added) covers half of it.
   std::vector<Detection> dets;
-  for (Detection& d : first_->Detect(input.bgr)) {
+  auto add = [&](Detection& d, bool unless_covered) {
     d.box &= image;
-    if (!d.box.empty() && Wanted(d.class_name)) dets.push_back(std::move(d));
-  }
-  timings_.second_added = 0;
-  if (second_) {
-    const size_t from_first = dets.size();
-    for (Detection& d : second_->Detect(input.bgr)) {
-      d.box &= image;
-      if (d.box.empty() || !Wanted(d.class_name)) continue;
-      // Kept only where no same-class box (of the first detector, or one already added) covers
-      // half of it.
-      bool covered = false;
-      for (const Detection& k : dets) {
-        if (k.class_name == d.class_name && (k.box & d.box).area() * 2 > d.box.area()) covered = true;
-      }
-      if (!covered) dets.push_back(std::move(d));
+    if (d.box.empty() || !Wanted(d.class_name)) return;
+    for (const Detection& k : dets) {
+      if (unless_covered && k.class_name == d.class_name && (k.box & d.box).area() * 2 > d.box.area()) return;
     }
-    timings_.second_added = static_cast<int>(dets.size() - from_first);
+    dets.push_back(std::move(d));
+  };
+  for (Detection& d : first_->Detect(input.bgr)) add(d, false);
+  const size_t from_first = dets.size();
+  if (second_) {
+    for (Detection& d : second_->Detect(input.bgr)) add(d, true);
   }
+  timings_.second_added = static_cast<int>(dets.size() - from_first);
   timings_.detect_ms = MsSince(t0);
   t0 = Clock::now();
   std::vector<Instance> out;
