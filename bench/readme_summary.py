@@ -90,9 +90,12 @@ def summary(bench_text):
         for r in ks:
             k = r["k"]
             if k.isdigit():
-                what = f"dnn segmenter (YOLOX-nano + Yolo-Fastest-xl), segment every {k} frame(s)"
-            else:  # e.g. "1 (YOLOX only)"
+                what = (f"dnn segmenter (YOLOX-nano + Yolo-Fastest-xl on every 2nd segmented frame), "
+                        f"segment every {k} frame(s)")
+            elif "YOLOX only" in k:
                 what = f"YOLOX-nano alone, segment every {k.split()[0]} frame(s)"
+            else:  # "1 (second detector every frame)"
+                what = f"YOLOX-nano + Yolo-Fastest-xl both on every frame, segment every {k.split()[0]} frame(s)"
             rows.append((f"Live threaded pipeline, {what}",
                          f"{r['fps (threaded, live dnn)']} fps", f"ATE {r['ATE mm (tracked)']} mm (walking_xyz seed 1)"))
     lines = ["| benchmark | frames | accuracy |", "|---|---|---|"]

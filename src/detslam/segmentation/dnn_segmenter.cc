@@ -80,6 +80,8 @@ bool DnnSegmenterOptions::Check(std::string* error) const {
     e = "score threshold must be in (0, 1)";
   else if (!(second_score_threshold > 0 && second_score_threshold < 1))
     e = "second detector score threshold must be in (0, 1)";
+  else if (second_every < 1)
+    e = "second detector interval must be at least 1";
   else if (!(nms_threshold > 0 && nms_threshold <= 1))
     e = "NMS threshold must be in (0, 1]";
   else if (!(box_expand >= 0 && box_expand <= 1))
@@ -178,6 +180,7 @@ DnnSegmenterOptions DnnOptionsFromSettings(const Settings& s, const std::string&
   o.second_names_path = resolve(s.GetString("Segmentation.SecondNames", ""));
   o.second_score_threshold = static_cast<float>(
       s.GetDouble("Segmentation.SecondScoreThreshold", o.second_score_threshold));
+  o.second_every = s.GetInt("Segmentation.SecondEvery", o.second_every);
   std::stringstream classes(s.GetString("Segmentation.DynamicClasses", ""));
   std::string item;
   while (std::getline(classes, item, ',')) {
@@ -342,9 +345,15 @@ std::vector<Instance> DnnSegmenter::Segment(const SegmenterInput& input) {
   };
   for (Detection& d : first_->Detect(input.bgr)) add(d, false);
   const size_t from_first = dets.size();
+  timings_.second_ran = false;
   if (second_) {
-    for (Detection& d : second_->Detect(input.bgr)) add(d, true);
+    if (calls_ % options_.second_every == 0) {
+      second_last_ = second_->Detect(input.bgr);
+      timings_.second_ran = true;
+    }
+    for (Detection d : second_last_) add(d, true);
   }
+  ++calls_;
   timings_.second_added = static_cast<int>(dets.size() - from_first);
   timings_.detect_ms = MsSince(t0);
   t0 = Clock::now();

@@ -39,6 +39,10 @@ struct DnnSegmenterOptions {
   std::string second_weights_path;
   std::string second_names_path;
   float second_score_threshold = 0.15f;
+  // The second detector runs on every `second_every`-th Segment() call (the first, then every
+  // N-th); the calls between reuse its last boxes (people move a few pixels per frame; the masks
+  // are still computed on the current image). 1 = every call.
+  int second_every = 2;
   DominantDepthOptions depth_mask;     // masks of classes without a mask model
 
   bool Check(std::string* error) const;
@@ -65,7 +69,8 @@ std::string DefaultModelsDir();
 //   Segmentation.PersonMaskMinFill  selfie mask fill of the box below which the depth mask is used
 //   Segmentation.SecondDetector  default <models_dir>/yolo_fastest_1.1/yolo-fastest-1.1-xl.cfg
 //                                ("none" = one detector); Segmentation.SecondWeights,
-//                                Segmentation.SecondNames, Segmentation.SecondScoreThreshold
+//                                Segmentation.SecondNames, Segmentation.SecondScoreThreshold,
+//                                Segmentation.SecondEvery (run it on every N-th call, default 2)
 //   Segmentation.DynamicClasses  comma-separated class names to return (default: all)
 DnnSegmenterOptions DnnOptionsFromSettings(const Settings& settings, const std::string& models_dir);
 
@@ -74,6 +79,7 @@ struct DnnTimings {
   double detect_ms = 0;  // preprocessing + network + decoding + NMS
   double mask_ms = 0;    // person masks and depth masks of all instances
   int second_added = 0;  // boxes added by the second detector
+  bool second_ran = false;  // the second detector ran in this call (else its last boxes were used)
 };
 
 class DnnSegmenter : public Segmenter {
@@ -103,6 +109,8 @@ class DnnSegmenter : public Segmenter {
   std::string name_;
   std::unique_ptr<Detector> first_;
   std::unique_ptr<Detector> second_;
+  std::vector<Detection> second_last_;  // the second detector's boxes from its last run
+  int64_t calls_ = 0;                   // Segment() calls so far
   std::unique_ptr<PersonMaskModel> person_mask_;
   DnnTimings timings_;
 };

@@ -160,5 +160,32 @@ TEST(DataDnnSegmenter, SecondDetectorAddsOnlyWhatTheFirstMissed) {
   }
 }
 
+TEST(DataDnnSegmenter, SecondDetectorOnEveryNthCallReusesItsBoxesBetween) {
+  DETSLAM_REQUIRE_SHARED("models/yolox_nano/yolox_nano.onnx");
+  DETSLAM_REQUIRE_SHARED("models/yolo_fastest_1.1/yolo-fastest-1.1-xl.weights");
+  DETSLAM_REQUIRE_SHARED(kReference);
+  const ClipFrame f = LoadClip();
+  DnnSegmenterOptions o;
+  o.detector_path = SharedPath("models/yolox_nano/yolox_nano.onnx");
+  o.second_detector_path = SharedPath("models/yolo_fastest_1.1/yolo-fastest-1.1-xl.cfg");
+  o.classes = {"person"};
+  o.score_threshold = 0.99f;  // the first detector finds nothing: every box is the second's
+  o.second_every = 3;
+  DnnSegmenter seg(o);
+  const cv::Mat black = cv::Mat::zeros(f.input.bgr.size(), CV_8UC3);
+  SegmenterInput blank = f.input;
+  blank.bgr = black;
+  // Call 0 runs the second detector on the real frame; calls 1 and 2 (on a black image, where it
+  // would find nobody) reuse those boxes; call 3 runs it again and finds nobody.
+  const std::vector<bool> ran = {true, false, false, true};
+  std::vector<size_t> found;
+  for (size_t call = 0; call < ran.size(); ++call) {
+    const auto people = People(seg.Segment(call == 0 ? f.input : blank));
+    EXPECT_EQ(seg.last_timings().second_ran, ran[call]) << "call " << call;
+    found.push_back(people.size());
+  }
+  EXPECT_EQ(found, (std::vector<size_t>{2, 2, 2, 0}));
+}
+
 }  // namespace
 }  // namespace detslam

@@ -111,7 +111,10 @@ TEST(DnnOptions, SecondDetectorDefaultIsOptionalAndExplicitOneIsKept) {
   Settings named;
   named.extra["Segmentation.SecondDetector"] = "other/body.cfg";
   named.extra["Segmentation.SecondScoreThreshold"] = "0.3";
+  named.extra["Segmentation.SecondEvery"] = "3";
+  EXPECT_EQ(DnnOptionsFromSettings(off, dir).second_every, 2);
   const DnnSegmenterOptions n = DnnOptionsFromSettings(named, "/m");
+  EXPECT_EQ(n.second_every, 3);
   EXPECT_EQ(n.second_detector_path, "/m/other/body.cfg");
   EXPECT_EQ(n.second_weights_path, "/m/other/body.weights");
   EXPECT_FLOAT_EQ(n.second_score_threshold, 0.3f);
@@ -141,6 +144,11 @@ TEST(DnnOptions, CheckRejectsBadValues) {
   o.second_score_threshold = 0.0f;
   EXPECT_FALSE(o.Check(&error));
   o.second_score_threshold = 0.15f;
+  o.second_every = 0;
+  EXPECT_FALSE(o.Check(&error));
+  EXPECT_NE(error.find("interval"), std::string::npos) << error;
+  o.second_every = 1;
+  EXPECT_TRUE(o.Check(&error)) << error;
   o.person_mask_min_fill = 1.0f;
   EXPECT_FALSE(o.Check(&error));
 }
