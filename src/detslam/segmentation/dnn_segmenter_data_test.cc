@@ -133,15 +133,28 @@ TEST(DataDnnSegmenter, YoloFastestXlFindsBothPeople) {
   ExpectBothPeopleBoxes("models/yolo_fastest_1.1/yolo-fastest-1.1-xl.cfg", "yolo_fastest_xl");
 }
 
-TEST(DataDnnSegmenter, SecondDetectorAddsOnlyWhatTheFirstMissed) {
-  DETSLAM_REQUIRE_SHARED("models/yolox_nano/yolox_nano.onnx");
-  DETSLAM_REQUIRE_SHARED("models/yolo_fastest_1.1/yolo-fastest-1.1-xl.weights");
-  DETSLAM_REQUIRE_SHARED(kReference);
-  const ClipFrame f = LoadClip();
+// YOLOX-nano first, Yolo-Fastest-xl second, people only.
+DnnSegmenterOptions TwoDetectorOptions() {
   DnnSegmenterOptions o;
   o.detector_path = SharedPath("models/yolox_nano/yolox_nano.onnx");
   o.second_detector_path = SharedPath("models/yolo_fastest_1.1/yolo-fastest-1.1-xl.cfg");
   o.classes = {"person"};
+  return o;
+}
+
+// Skips (fails in CI) the calling test when the models or the reference frame are missing; the
+// caller returns when the test is skipped or failed.
+void RequireTwoDetectorData() {
+  DETSLAM_REQUIRE_SHARED("models/yolox_nano/yolox_nano.onnx");
+  DETSLAM_REQUIRE_SHARED("models/yolo_fastest_1.1/yolo-fastest-1.1-xl.weights");
+  DETSLAM_REQUIRE_SHARED(kReference);
+}
+
+TEST(DataDnnSegmenter, SecondDetectorAddsOnlyWhatTheFirstMissed) {
+  RequireTwoDetectorData();
+  if (::testing::Test::IsSkipped() || ::testing::Test::HasFatalFailure()) return;
+  const ClipFrame f = LoadClip();
+  DnnSegmenterOptions o = TwoDetectorOptions();
   // Both detectors find both people: the second one adds no duplicate.
   DnnSegmenter both(o);
   EXPECT_EQ(People(both.Segment(f.input)).size(), 2u);
@@ -161,14 +174,10 @@ TEST(DataDnnSegmenter, SecondDetectorAddsOnlyWhatTheFirstMissed) {
 }
 
 TEST(DataDnnSegmenter, SecondDetectorOnEveryNthCallReusesItsBoxesBetween) {
-  DETSLAM_REQUIRE_SHARED("models/yolox_nano/yolox_nano.onnx");
-  DETSLAM_REQUIRE_SHARED("models/yolo_fastest_1.1/yolo-fastest-1.1-xl.weights");
-  DETSLAM_REQUIRE_SHARED(kReference);
+  RequireTwoDetectorData();
+  if (::testing::Test::IsSkipped() || ::testing::Test::HasFatalFailure()) return;
   const ClipFrame f = LoadClip();
-  DnnSegmenterOptions o;
-  o.detector_path = SharedPath("models/yolox_nano/yolox_nano.onnx");
-  o.second_detector_path = SharedPath("models/yolo_fastest_1.1/yolo-fastest-1.1-xl.cfg");
-  o.classes = {"person"};
+  DnnSegmenterOptions o = TwoDetectorOptions();
   o.score_threshold = 0.99f;  // the first detector finds nothing: every box is the second's
   o.second_every = 3;
   DnnSegmenter seg(o);
