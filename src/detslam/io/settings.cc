@@ -401,7 +401,8 @@ void ApplySettingOverrides(const std::vector<std::string>& overrides, Settings* 
     }
     settings->extra[key] = o.substr(eq + 1);
   }
-  if (!overrides.empty()) settings->source += " + --set overrides";
+  // The source names every override, so run.json records how the run was configured.
+  for (const std::string& o : overrides) settings->source += " + --set " + o;
 }
 
 }  // namespace detslam

@@ -238,6 +238,28 @@ TEST_F(SettingsTest, TypedGettersUseFallbackAndRejectWrongTypes) {
   EXPECT_THAT(error([&] { s.GetBool("n", false); }), HasSubstr("key 'n' must be a boolean"));
 }
 
+TEST_F(SettingsTest, OverridesSetKeysAndAreNamedInTheSource) {
+  Settings s;
+  s.source = "cfg.yaml";
+  s.extra = {{"Dynamic.Alpha", "0.1"}};
+  ApplySettingOverrides({"Dynamic.Alpha=0.2", "Segmentation.SecondEvery=1"}, &s);
+  EXPECT_DOUBLE_EQ(s.GetDouble("Dynamic.Alpha", 0), 0.2);
+  EXPECT_EQ(s.GetInt("Segmentation.SecondEvery", 2), 1);
+  EXPECT_EQ(s.source, "cfg.yaml + --set Dynamic.Alpha=0.2 + --set Segmentation.SecondEvery=1");
+  // A bad value is reported with the override that set it.
+  try {
+    ApplySettingOverrides({"Tracking.X=abc"}, &s);
+    s.GetInt("Tracking.X", 0);
+    ADD_FAILURE() << "no InputError";
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("--set Tracking.X=abc"));
+  }
+  for (const std::string bad : {"NoValue", "=1", "Key=", "Camera.fx=500", "ORBextractor.nFeatures=10"}) {
+    Settings t;
+    EXPECT_THROW(ApplySettingOverrides({bad}, &t), InputError) << bad;
+  }
+}
+
 TEST_F(SettingsTest, WriteReadRoundTripIsOpenCvReadable) {
   Settings s = PresetByName("fr2");
   s.camera.fx = 520.0;  // integral value must still be written as a real

@@ -310,7 +310,9 @@ DnnSegmenter::DnnSegmenter(const DnnSegmenterOptions& options) : options_(option
     person_mask_ = std::make_unique<PersonMaskModel>(o.person_mask_model);
   }
   name_ = "dnn:" + fs::path(o.detector_path).filename().string() +
-          (second_ ? "+" + fs::path(o.second_detector_path).filename().string() : "") +
+          (second_ ? "+" + fs::path(o.second_detector_path).filename().string() +
+                         (o.second_every > 1 ? "(every " + std::to_string(o.second_every) + ")" : "")
+                   : "") +
           (person_mask_ ? "+" + fs::path(o.person_mask_model).filename().string() : "");
   spdlog::debug("segmenter {} with {} classes", name_, first_->names().size());
 }

@@ -181,6 +181,7 @@ TEST(DataDnnSegmenter, SecondDetectorOnEveryNthCallReusesItsBoxesBetween) {
   o.score_threshold = 0.99f;  // the first detector finds nothing: every box is the second's
   o.second_every = 3;
   DnnSegmenter seg(o);
+  EXPECT_EQ(seg.name(), "dnn:yolox_nano.onnx+yolo-fastest-1.1-xl.cfg(every 3)");
   const cv::Mat black = cv::Mat::zeros(f.input.bgr.size(), CV_8UC3);
   SegmenterInput blank = f.input;
   blank.bgr = black;
