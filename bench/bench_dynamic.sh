@@ -18,6 +18,7 @@
 #   env: PRESETS="walking_xyz walking_static walking_rpy walking_halfsphere sitting_static"
 #        SEEDS="1 2 3"  FRAMES=300  JOBS=2  KS="1 2 3 5"
 #        SPREAD_PRESETS="walking_xyz" (presets whose runs are repeated with a perturbed setting)
+#        REPEATS=3 (live threaded runs per configuration of the every-k table; median reported)
 set -euo pipefail
 here="$(cd "$(dirname "$0")" && pwd)"
 root="$(dirname "$here")"
@@ -28,6 +29,7 @@ seeds="${SEEDS:-1 2 3}"
 frames="${FRAMES:-300}"
 jobs="${JOBS:-2}"
 ks="${KS:-1 2 3 5}"
+repeats="${REPEATS:-3}"
 spread_presets="${SPREAD_PRESETS:-walking_xyz}"
 people="$shared/data/people"
 models="$shared/models"
@@ -116,35 +118,51 @@ if [[ ! -d "$kseq" ]]; then
   "$bin" synth --preset walking_xyz --seed 1 --frames "$frames" --people "$people" --out "$kseq" >/dev/null 2>&1
   "$bin" segment --dataset "$kseq" --models "$models" --out "$kseq.dnnmasks" >/dev/null 2>&1
 fi
-# k_row LABEL ACC ACC_TRACKED RUN_JSON -> one row of the every-k table
-k_row() {
-  python3 - "$@" <<'PY'
-import json, sys
-k, acc, acc_tr, run = sys.argv[1:]
-d = json.load(open(run)); t = d["timings"]
-seg = [r["segmentation_ms"] for r in d["per_frame"]]
-print(f"| {k} | {float(acc):.1f} ({acc_tr}) | {d['frames'] / d['wall_s']:.1f} | {sum(seg) / len(seg):.1f} | {t['extraction']['median_ms']:.1f} | {t['tracking']['median_ms']:.1f} |")
-PY
-}
-for k in $ks; do
-  echo "[bench_dynamic] every k-th frame: k = $k" >&2
-  read -r acc acc_tr < <(run_eval "$kseq" "$kseq.k$k" --segmenter "masks:$kseq.dnnmasks" --segment-every "$k")
-  "$bin" run --dataset "$kseq" --out "$kseq.live$k" --no-progress --models "$models" --segmenter dnn --threaded \
-      --segment-every "$k" >"$kseq.live$k.log" 2>&1
-  k_rows+=$(k_row "$k" "$acc" "$acc_tr" "$kseq.live$k/run.json")$'\n'
+# Configurations of the every-k table: LABEL|SEGMENT-OPTIONS|RUN-OPTIONS (k = 1 is the default).
+configs=()
+for k in $ks; do configs+=("$k||--segment-every $k"); done
+configs+=("1 (YOLOX only)|--set Segmentation.SecondDetector=none|--set Segmentation.SecondDetector=none")
+configs+=("1 (second detector every frame)|--set Segmentation.SecondEvery=1|--set Segmentation.SecondEvery=1")
+# Accuracy (sequential, deterministic) from masks replayed with the run's segmentation options.
+declare -A acc_of
+for i in "${!configs[@]}"; do
+  IFS='|' read -r label seg_opts run_opts <<<"${configs[$i]}"
+  echo "[bench_dynamic] every k-th frame: $label" >&2
+  masks="$kseq.dnnmasks"
+  if [[ -n "$seg_opts" ]]; then
+    masks="$kseq.dnnmasks.$i"
+    # shellcheck disable=SC2086
+    "$bin" segment --dataset "$kseq" --models "$models" --out "$masks" $seg_opts >/dev/null 2>&1
+  fi
+  # shellcheck disable=SC2086
+  acc_of[$i]=$(run_eval "$kseq" "$kseq.acc$i" --segmenter "masks:$masks" $run_opts)
 done
-# k = 1 with the first detector alone (the speed of YOLOX-nano without the second detector).
-"$bin" segment --dataset "$kseq" --models "$models" --out "$kseq.dnnmasks1" --set Segmentation.SecondDetector=none >/dev/null 2>&1
-read -r acc acc_tr < <(run_eval "$kseq" "$kseq.k1only" --segmenter "masks:$kseq.dnnmasks1")
-"$bin" run --dataset "$kseq" --out "$kseq.live1only" --no-progress --models "$models" --segmenter dnn --threaded \
-    --set Segmentation.SecondDetector=none >"$kseq.live1only.log" 2>&1
-k_rows+=$(k_row "1 (YOLOX only)" "$acc" "$acc_tr" "$kseq.live1only/run.json")$'\n'
-# k = 1 with the second detector on every frame (default: every 2nd segmented frame).
-"$bin" segment --dataset "$kseq" --models "$models" --out "$kseq.dnnmasks2all" --set Segmentation.SecondEvery=1 >/dev/null 2>&1
-read -r acc acc_tr < <(run_eval "$kseq" "$kseq.k1second" --segmenter "masks:$kseq.dnnmasks2all")
-"$bin" run --dataset "$kseq" --out "$kseq.live1second" --no-progress --models "$models" --segmenter dnn --threaded \
-    --set Segmentation.SecondEvery=1 >"$kseq.live1second.log" 2>&1
-k_rows+=$(k_row "1 (second detector every frame)" "$acc" "$acc_tr" "$kseq.live1second/run.json")$'\n'
+# Speed: the live threaded runs, REPEATS rounds over all configurations (interleaved, so a drift
+# of the machine's speed touches every configuration alike); the median run is reported.
+for ((r = 1; r <= repeats; r++)); do
+  for i in "${!configs[@]}"; do
+    IFS='|' read -r label seg_opts run_opts <<<"${configs[$i]}"
+    echo "[bench_dynamic] live threaded run $r/$repeats: $label" >&2
+    # shellcheck disable=SC2086
+    "$bin" run --dataset "$kseq" --out "$kseq.live$i.$r" --no-progress --models "$models" --segmenter dnn \
+        --threaded $run_opts >"$kseq.live$i.$r.log" 2>&1
+  done
+done
+k_rows=""
+for i in "${!configs[@]}"; do
+  IFS='|' read -r label seg_opts run_opts <<<"${configs[$i]}"
+  k_rows+=$(python3 - "$label" ${acc_of[$i]} "$kseq.live$i".*/run.json <<'PY'
+import json, statistics, sys
+k, acc, acc_tr, *runs = sys.argv[1:]
+ds = sorted((json.load(open(p)) for p in runs), key=lambda d: d["frames"] / d["wall_s"])
+fps = [d["frames"] / d["wall_s"] for d in ds]
+d = ds[len(ds) // 2]; t = d["timings"]
+seg = [r["segmentation_ms"] for r in d["per_frame"]]
+spread = f" ({fps[0]:.1f}-{fps[-1]:.1f})" if len(fps) > 1 else ""
+print(f"| {k} | {float(acc):.1f} ({acc_tr}) | {fps[len(fps) // 2]:.1f}{spread} | {sum(seg) / len(seg):.1f} | {t['extraction']['median_ms']:.1f} | {t['tracking']['median_ms']:.1f} |")
+PY
+)$'\n'
+done
 
 {
   echo "Synthetic walking presets, $frames frames each, people textured with the TUM cut-outs"
@@ -182,7 +200,8 @@ k_rows+=$(k_row "1 (second detector every frame)" "$acc" "$acc_tr" "$kseq.live1s
   echo "2 px per frame in between), walking_xyz seed 1. Accuracy from replayed dnn masks (sequential);"
   echo "speed of the whole threaded pipeline with the live dnn segmenter (\`--threaded\`:"
   echo "loading+segmentation, extraction+filter, tracking and local mapping threads), measured alone"
-  echo "on the machine. k = 1 is the default. The last rows: k = 1 with YOLOX-nano alone"
+  echo "on the machine in $repeats interleaved rounds over all rows (this virtual machine's speed drifts"
+  echo "by 10-20 % within minutes): median fps (range), timings of the median run. k = 1 is the default. The last rows: k = 1 with YOLOX-nano alone"
   echo "(\`--set Segmentation.SecondDetector=none\`), and k = 1 with the second detector run on every"
   echo "frame instead of every 2nd (\`--set Segmentation.SecondEvery=1\`)."
   echo
@@ -190,6 +209,7 @@ k_rows+=$(k_row "1 (second detector every frame)" "$acc" "$acc_tr" "$kseq.live1s
   echo "|---:|---:|---:|---:|---:|---:|"
   printf '%s' "$k_rows"
 } >"$work/section.md"
-python3 "$here/update_section.py" dynamic "bench/bench_dynamic.sh (PRESETS=\"$presets\" SEEDS=\"$seeds\" FRAMES=$frames JOBS=$jobs KS=\"$ks\" SPREAD_PRESETS=\"$spread_presets\")" <"$work/section.md"
+python3 "$here/update_section.py" dynamic "bench/bench_dynamic.sh (PRESETS=\"$presets\" SEEDS=\"$seeds\" FRAMES=$frames JOBS=$jobs KS=\"$ks\" SPREAD_PRESETS=\"$spread_presets\" REPEATS=$repeats)" <"$work/section.md"
 cat "$work/section.md"
 python3 "$here/readme_summary.py"
+python3 "$here/plot_dynamic.py"
