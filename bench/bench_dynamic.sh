@@ -83,12 +83,13 @@ PY
     # Spread: the same twin and filtered runs with the keyframe far-point budget moved by +-20
     # (Tracking.KeyFrameFarPoints 280 / 320 around the default 300), a change with no bearing on
     # people, to show how much a single run's ATE moves.
-    local t280 t320 f280 f320 unused
-    read -r t280 unused < <(run_eval "$seq.twin" "$seq.twin.run280" --segmenter none --set Tracking.KeyFrameFarPoints=280)
-    read -r t320 unused < <(run_eval "$seq.twin" "$seq.twin.run320" --segmenter none --set Tracking.KeyFrameFarPoints=320)
-    read -r f280 unused < <(run_eval "$seq" "$seq.full280" --segmenter "masks:$seq.dnnmasks" --set Tracking.KeyFrameFarPoints=280)
-    read -r f320 unused < <(run_eval "$seq" "$seq.full320" --segmenter "masks:$seq.dnnmasks" --set Tracking.KeyFrameFarPoints=320)
-    python3 - "$preset" "$seed" "$t280" "$twin" "$t320" "$f280" "$full" "$f320" >"$work/rows/${preset}_$seed.spread" <<'PY'
+    local fp unused
+    local -A t f
+    for fp in 280 320; do
+      read -r "t[$fp]" unused < <(run_eval "$seq.twin" "$seq.twin.run$fp" --segmenter none --set Tracking.KeyFrameFarPoints=$fp)
+      read -r "f[$fp]" unused < <(run_eval "$seq" "$seq.full$fp" --segmenter "masks:$seq.dnnmasks" --set Tracking.KeyFrameFarPoints=$fp)
+    done
+    python3 - "$preset" "$seed" "${t[280]}" "$twin" "${t[320]}" "${f[280]}" "$full" "${f[320]}" >"$work/rows/${preset}_$seed.spread" <<'PY'
 import sys
 preset, seed, *v = sys.argv[1:]
 t, f = [float(x) for x in v[:3]], [float(x) for x in v[3:]]
@@ -97,7 +98,7 @@ print(f"| {preset} | {seed} | {cell(t)} | {cell(f)} | {' / '.join(f'{b / a:.2f}'
 PY
   fi
   [[ "$preset" == "walking_xyz" && "$seed" == "1" ]] && return 0  # kept for the every-k table
-  rm -rf "$seq" "$seq.twin" "$seq.dnnmasks" "$seq".*.run* "$seq".full* "$seq".none "$seq".mask "$seq".depth "$seq".full "$seq".gt
+  rm -rf "$seq" "$seq.twin" "$seq.dnnmasks" "$seq".*.run* "$seq".full* "$seq".none "$seq".mask "$seq".depth "$seq".gt
 }
 export -f job
 
@@ -152,7 +153,7 @@ k_rows=""
 for i in "${!configs[@]}"; do
   IFS='|' read -r label seg_opts run_opts <<<"${configs[$i]}"
   k_rows+=$(python3 - "$label" ${acc_of[$i]} "$kseq.live$i".*/run.json <<'PY'
-import json, statistics, sys
+import json, sys
 k, acc, acc_tr, *runs = sys.argv[1:]
 ds = sorted((json.load(open(p)) for p in runs), key=lambda d: d["frames"] / d["wall_s"])
 fps = [d["frames"] / d["wall_s"] for d in ds]

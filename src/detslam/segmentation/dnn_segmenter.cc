@@ -74,26 +74,26 @@ bool DnnSegmenterOptions::Check(std::string* error) const {
       e = DetectorFormatError(second_detector_path, "second");
     }
   }
-  if (!e.empty()) {
-    // reported below
-  } else if (!(score_threshold > 0 && score_threshold < 1))
-    e = "score threshold must be in (0, 1)";
-  else if (!(second_score_threshold > 0 && second_score_threshold < 1))
-    e = "second detector score threshold must be in (0, 1)";
-  else if (second_every < 1)
-    e = "second detector interval must be at least 1";
-  else if (!(nms_threshold > 0 && nms_threshold <= 1))
-    e = "NMS threshold must be in (0, 1]";
-  else if (!(box_expand >= 0 && box_expand <= 1))
-    e = "box expansion must be in [0, 1]";
-  else if (yolox_input_size <= 0 || yolox_input_size % 32 != 0)
-    e = "YOLOX input size must be a positive multiple of 32";
-  else if (darknet_input_size <= 0 || darknet_input_size % 32 != 0)
-    e = "Darknet input size must be a positive multiple of 32";
-  else if (!(person_mask_threshold > 0 && person_mask_threshold < 1))
-    e = "person mask threshold must be in (0, 1)";
-  else if (!(person_mask_min_fill >= 0 && person_mask_min_fill < 1))
-    e = "person mask minimum fill must be in [0, 1)";
+  if (e.empty()) {
+    if (!(score_threshold > 0 && score_threshold < 1))
+      e = "score threshold must be in (0, 1)";
+    else if (!(second_score_threshold > 0 && second_score_threshold < 1))
+      e = "second detector score threshold must be in (0, 1)";
+    else if (second_every < 1)
+      e = "second detector interval must be at least 1";
+    else if (!(nms_threshold > 0 && nms_threshold <= 1))
+      e = "NMS threshold must be in (0, 1]";
+    else if (!(box_expand >= 0 && box_expand <= 1))
+      e = "box expansion must be in [0, 1]";
+    else if (yolox_input_size <= 0 || yolox_input_size % 32 != 0)
+      e = "YOLOX input size must be a positive multiple of 32";
+    else if (darknet_input_size <= 0 || darknet_input_size % 32 != 0)
+      e = "Darknet input size must be a positive multiple of 32";
+    else if (!(person_mask_threshold > 0 && person_mask_threshold < 1))
+      e = "person mask threshold must be in (0, 1)";
+    else if (!(person_mask_min_fill >= 0 && person_mask_min_fill < 1))
+      e = "person mask minimum fill must be in [0, 1)";
+  }
   if (e.empty()) depth_mask.Check(&e);
   if (!e.empty() && error != nullptr) *error = e;
   return e.empty();
