@@ -14,6 +14,7 @@ bool PinholeCamera::Check(std::string* error) const {
   if (!(depth_map_factor > 0)) os << "DepthMapFactor must be positive; ";
   if (!(bf > 0)) os << "bf (baseline * fx) must be positive; ";
   if (!(th_depth > 0)) os << "ThDepth must be positive; ";
+  if (!(disparity_sigma >= 0)) os << "DisparitySigma must be >= 0; ";
   if (!(fps > 0)) os << "fps must be positive; ";
   if (error != nullptr) *error = os.str();
   return os.str().empty();

@@ -11,6 +11,14 @@ namespace detslam {
 // horizontal coordinate in the virtual right camera of the RGB-D sensor.
 Eigen::Vector3d ProjectStereo(const PinholeCamera& camera, const Eigen::Vector3d& p_cam);
 
+// Whitened residual (projection - observation) of an RGB-D observation (uv, u_right) of a
+// camera-frame point (z > 0): the (u, v) error times sqrt_info (1 / sigma of the keypoint's
+// octave) and, third, the disparity error (bf / z - (u - u_right)) over camera.disparity_sigma;
+// with disparity_sigma = 0 the third entry is ORB-SLAM3's u_right error times sqrt_info. Its
+// squared norm is the chi2 of the observation.
+Eigen::Vector3d WhitenedStereoResidual(const PinholeCamera& camera, const Eigen::Vector3d& p_cam,
+                                       const Eigen::Vector2d& uv, double u_right, double sqrt_info);
+
 // Normalised image coordinates (x/z, y/z) of an undistorted pixel.
 inline Eigen::Vector2d PixelToNormalized(const PinholeCamera& camera, const Eigen::Vector2d& uv) {
   return {(uv.x() - camera.cx) / camera.fx, (uv.y() - camera.cy) / camera.fy};

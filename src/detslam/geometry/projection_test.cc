@@ -25,6 +25,22 @@ TEST(ProjectionTest, ProjectStereoHandMadeNumbers) {
   EXPECT_DOUBLE_EQ(uvr.z(), 350.0);
 }
 
+TEST(ProjectionTest, WhitenedStereoResidualHandMadeNumbers) {
+  // Point as above (u 370, v 220, u_right 350, disparity bf / z = 20); observed (371, 218) with
+  // u_right 349.5, i.e. disparity 21.5; sqrt_info 0.5.
+  PinholeCamera camera = HandCamera();
+  const Eigen::Vector3d p(0.2, -0.1, 2.0);
+  const Eigen::Vector2d uv(371.0, 218.0);
+  camera.disparity_sigma = 0.5;
+  Eigen::Vector3d r = WhitenedStereoResidual(camera, p, uv, 349.5, 0.5);
+  EXPECT_DOUBLE_EQ(r.x(), 0.5 * (370.0 - 371.0));
+  EXPECT_DOUBLE_EQ(r.y(), 0.5 * (220.0 - 218.0));
+  EXPECT_DOUBLE_EQ(r.z(), (20.0 - 21.5) / 0.5);
+  camera.disparity_sigma = 0.0;  // ORB-SLAM3: u_right error with the keypoint's sigma
+  r = WhitenedStereoResidual(camera, p, uv, 349.5, 0.5);
+  EXPECT_DOUBLE_EQ(r.z(), 0.5 * (350.0 - 349.5));
+}
+
 TEST(ProjectionTest, PixelToNormalizedInvertsProjection) {
   const Eigen::Vector2d xn = PixelToNormalized(HandCamera(), Eigen::Vector2d(370.0, 220.0));
   EXPECT_DOUBLE_EQ(xn.x(), 0.1);

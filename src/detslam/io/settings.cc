@@ -314,10 +314,12 @@ Settings ReadSettings(const std::string& path) {
     if (r.Has("Stereo.b")) c.bf = r.Double("Stereo.b", 0.0) * c.fx;
     c.th_depth = r.Double("Stereo.ThDepth", c.th_depth);
     c.depth_map_factor = r.Double("RGBD.DepthMapFactor", c.depth_map_factor);
+    c.disparity_sigma = r.Double("RGBD.DisparitySigma", c.disparity_sigma);
   } else {
     c.bf = r.Double("Camera.bf", c.bf);
     c.th_depth = r.Double("ThDepth", c.th_depth);
     c.depth_map_factor = r.Double("DepthMapFactor", c.depth_map_factor);
+    c.disparity_sigma = r.Double("DisparitySigma", c.disparity_sigma);
   }
   OrbSettings& o = s.orb;
   o.n_features = r.Int("ORBextractor.nFeatures", o.n_features);
@@ -359,6 +361,7 @@ void WriteSettings(const std::string& path, const Settings& settings) {
       {"Stereo.ThDepth", FormatReal(c.th_depth)},
       {"Stereo.b", FormatReal(c.bf / c.fx)},
       {"RGBD.DepthMapFactor", FormatReal(c.depth_map_factor)},
+      {"RGBD.DisparitySigma", FormatReal(c.disparity_sigma)},
       {"ORBextractor.nFeatures", std::to_string(o.n_features)},
       {"ORBextractor.scaleFactor", FormatReal(o.scale_factor)},
       {"ORBextractor.nLevels", std::to_string(o.n_levels)},

@@ -129,6 +129,7 @@ Camera.RGB: 0
 Stereo.ThDepth: 35.0
 Stereo.b: 0.0747
 RGBD.DepthMapFactor: 5000.0
+RGBD.DisparitySigma: 0.25
 )");
   const Settings s = ReadSettings(path);
   EXPECT_DOUBLE_EQ(s.camera.fx, 535.4);
@@ -137,6 +138,7 @@ RGBD.DepthMapFactor: 5000.0
   EXPECT_DOUBLE_EQ(s.camera.bf, 0.0747 * 535.4);
   EXPECT_NEAR(s.camera.Baseline(), 0.0747, 1e-12);
   EXPECT_DOUBLE_EQ(s.camera.th_depth, 35.0);
+  EXPECT_DOUBLE_EQ(s.camera.disparity_sigma, 0.25);
   EXPECT_DOUBLE_EQ(s.camera.fps, 30.0);
   EXPECT_FALSE(s.camera.rgb_order);
   EXPECT_EQ(s.orb.n_features, OrbSettings().n_features);  // defaults where absent
@@ -192,6 +194,8 @@ TEST_F(SettingsTest, CameraAndOrbChecksAreReportedWithTheFile) {
   const std::string error = ReadError(path);
   EXPECT_THAT(error, StartsWith(path));
   EXPECT_THAT(error, HasSubstr("DepthMapFactor must be positive"));
+  text = std::string(kOldStyle) + "DisparitySigma: -0.1\n";
+  EXPECT_THAT(ReadError(Write("disparity.yaml", text)), HasSubstr("DisparitySigma must be >= 0"));
   text = kOldStyle;
   text.replace(text.find("ORBextractor.scaleFactor: 1.25"), 30, "ORBextractor.scaleFactor: 0.9");
   EXPECT_THAT(ReadError(Write("orb.yaml", text)), HasSubstr("scaleFactor"));
@@ -264,6 +268,7 @@ TEST_F(SettingsTest, WriteReadRoundTripIsOpenCvReadable) {
   Settings s = PresetByName("fr2");
   s.camera.fx = 520.0;  // integral value must still be written as a real
   s.camera.bf = 0.075 * 520.0;
+  s.camera.disparity_sigma = 0.0;  // ORB-SLAM3's u_right model survives the round trip
   s.orb.n_features = 1234;
   s.extra = {{"Viewer.KeyFrameSize", "0.05"},
              {"System.SaveAtlasToFile", "my map \"v2\".osa"},
@@ -290,6 +295,7 @@ TEST_F(SettingsTest, WriteReadRoundTripIsOpenCvReadable) {
   EXPECT_NEAR(back.camera.bf, s.camera.bf, 1e-9);
   EXPECT_DOUBLE_EQ(back.camera.depth_map_factor, 5208.0);
   EXPECT_DOUBLE_EQ(back.camera.th_depth, s.camera.th_depth);
+  EXPECT_DOUBLE_EQ(back.camera.disparity_sigma, 0.0);
   EXPECT_EQ(back.camera.width, s.camera.width);
   EXPECT_EQ(back.orb.n_features, 1234);
   EXPECT_DOUBLE_EQ(back.orb.scale_factor, s.orb.scale_factor);

@@ -157,15 +157,10 @@ BundleSummary SolveBundle(const PinholeCamera& camera, BundleProblem* problem,
       summary.outlier[i] = true;
       continue;
     }
-    const Eigen::Vector3d proj = ProjectStereo(camera, p_cam);
-    double chi2;
-    if (o.u_right >= 0.0) {
-      chi2 = o.inv_sigma2 * (proj - Eigen::Vector3d(o.uv.x(), o.uv.y(), o.u_right)).squaredNorm();
-      summary.outlier[i] = chi2 > options.chi2_stereo;
-    } else {
-      chi2 = o.inv_sigma2 * (proj.head<2>() - o.uv).squaredNorm();
-      summary.outlier[i] = chi2 > options.chi2_mono;
-    }
+    const Eigen::Vector3d r =
+        WhitenedStereoResidual(camera, p_cam, o.uv, o.u_right, std::sqrt(o.inv_sigma2));
+    summary.outlier[i] = o.u_right >= 0.0 ? r.squaredNorm() > options.chi2_stereo
+                                          : r.head<2>().squaredNorm() > options.chi2_mono;
   }
   return summary;
 }

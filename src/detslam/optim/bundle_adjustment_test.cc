@@ -16,10 +16,17 @@ struct Scene {
   BundleProblem problem;  // noisy observations, perturbed poses (except the first) and points
 };
 
-// 10 cameras on a 1.8 m line looking along +z, 200 points 2-4 m away, 1 px noise; even
-// observations are stereo.
-Scene MakeScene(Rng& rng) {
-  const PinholeCamera camera;
+// ORB-SLAM3's observation model: u_right as noisy as u (disparity_sigma 0).
+PinholeCamera URightCamera() {
+  PinholeCamera c;
+  c.disparity_sigma = 0.0;
+  return c;
+}
+
+// 10 cameras on a 1.8 m line looking along +z, 200 points 2-4 m away, 1 px noise on (u, v); even
+// observations are stereo, with noise as the camera's model says: u_right with 1 px noise of
+// its own (disparity_sigma 0), or a disparity u - u_right with disparity_sigma noise.
+Scene MakeScene(Rng& rng, const PinholeCamera& camera = URightCamera()) {
   Scene s;
   for (int i = 0; i < 10; ++i) {
     Vector6d world_from_cam;
@@ -39,7 +46,11 @@ Scene MakeScene(Rng& rng) {
       o.pose_index = i;
       o.point_index = j;
       o.uv = uvr.head<2>() + Eigen::Vector2d(rng.Normal(), rng.Normal());
-      if ((i + j) % 2 == 0) o.u_right = uvr.z() + rng.Normal();
+      if ((i + j) % 2 == 0) {
+        o.u_right = camera.disparity_sigma > 0
+                        ? o.uv.x() - (camera.bf / p_cam.z() + rng.Normal(0, camera.disparity_sigma))
+                        : uvr.z() + rng.Normal();
+      }
       s.truth.observations.push_back(o);
     }
   }
@@ -80,7 +91,7 @@ TEST(BundleAdjustmentTest, MovesPosesAndPointsTowardsTheTruth) {
   const double pose_before = MeanPoseError(s.problem, s.truth);
   const double point_before = MeanPointError(s.problem, s.truth);
   const Rigid3d first = s.problem.poses[0].cam_from_world;
-  const BundleSummary summary = SolveBundle(PinholeCamera(), &s.problem, BundleOptions());
+  const BundleSummary summary = SolveBundle(URightCamera(), &s.problem, BundleOptions());
   ASSERT_TRUE(summary.usable);
   EXPECT_GT(summary.iterations, 0);
   EXPECT_LE(summary.iterations, BundleOptions().max_iterations);
@@ -99,6 +110,27 @@ TEST(BundleAdjustmentTest, MovesPosesAndPointsTowardsTheTruth) {
   EXPECT_LT(flagged, 0.1 * summary.outlier.size());
 }
 
+// With the disparity model (the default camera) and data of that model, BA converges, and it
+// recovers the points better than the u_right model does on the same data.
+TEST(BundleAdjustmentTest, DisparityModelWeightsDepthByItsNoise) {
+  const PinholeCamera camera;  // disparity_sigma 0.1 px
+  ASSERT_GT(camera.disparity_sigma, 0.0);
+  Rng rng(5);
+  Scene s = MakeScene(rng, camera);
+  BundleProblem with_u_right = s.problem;
+  const double point_before = MeanPointError(s.problem, s.truth);
+  const BundleSummary summary = SolveBundle(camera, &s.problem, BundleOptions());
+  ASSERT_TRUE(summary.usable);
+  EXPECT_LT(MeanPoseError(s.problem, s.truth), 0.01);
+  const double point_after = MeanPointError(s.problem, s.truth);
+  EXPECT_LT(point_after, 0.3 * point_before) << point_before << " -> " << point_after;
+  int flagged = 0;
+  for (const bool o : summary.outlier) flagged += o ? 1 : 0;
+  EXPECT_LT(flagged, 0.1 * summary.outlier.size());
+  ASSERT_TRUE(SolveBundle(URightCamera(), &with_u_right, BundleOptions()).usable);
+  EXPECT_LT(point_after, MeanPointError(with_u_right, s.truth)) << point_after << " vs " << MeanPointError(with_u_right, s.truth);
+}
+
 TEST(BundleAdjustmentTest, FlagsCorruptedObservations) {
   Rng rng(2);
   Scene s = MakeScene(rng);
@@ -108,7 +140,7 @@ TEST(BundleAdjustmentTest, FlagsCorruptedObservations) {
     corrupted.push_back(k);
   }
   ASSERT_GE(corrupted.size(), 10u);
-  const BundleSummary summary = SolveBundle(PinholeCamera(), &s.problem, BundleOptions());
+  const BundleSummary summary = SolveBundle(URightCamera(), &s.problem, BundleOptions());
   ASSERT_TRUE(summary.usable);
   for (const size_t k : corrupted) EXPECT_TRUE(summary.outlier[k]) << k;
   EXPECT_LT(MeanPoseError(s.problem, s.truth), 0.01);
@@ -119,7 +151,7 @@ TEST(BundleAdjustmentTest, AbortFlagStopsBeforeTheFirstStep) {
   Scene s = MakeScene(rng);
   const BundleProblem before = s.problem;
   const std::atomic<bool> abort(true);
-  const BundleSummary summary = SolveBundle(PinholeCamera(), &s.problem, BundleOptions(), &abort);
+  const BundleSummary summary = SolveBundle(URightCamera(), &s.problem, BundleOptions(), &abort);
   EXPECT_EQ(summary.iterations, 0);
   EXPECT_EQ(summary.final_cost, summary.initial_cost);
   for (size_t i = 0; i < before.poses.size(); ++i) {
@@ -129,7 +161,7 @@ TEST(BundleAdjustmentTest, AbortFlagStopsBeforeTheFirstStep) {
   EXPECT_EQ(MeanPointError(s.problem, before), 0.0);
   // An unset flag does not interfere.
   const std::atomic<bool> go(false);
-  EXPECT_GT(SolveBundle(PinholeCamera(), &s.problem, BundleOptions(), &go).iterations, 0);
+  EXPECT_GT(SolveBundle(URightCamera(), &s.problem, BundleOptions(), &go).iterations, 0);
 }
 
 TEST(BundleAdjustmentTest, NoFixedPoseIsNotUsableAndBadInputThrows) {
@@ -137,17 +169,17 @@ TEST(BundleAdjustmentTest, NoFixedPoseIsNotUsableAndBadInputThrows) {
   Scene s = MakeScene(rng);
   s.problem.poses[0].fixed = false;
   const BundleProblem before = s.problem;
-  const BundleSummary summary = SolveBundle(PinholeCamera(), &s.problem, BundleOptions());
+  const BundleSummary summary = SolveBundle(URightCamera(), &s.problem, BundleOptions());
   EXPECT_FALSE(summary.usable);
   EXPECT_EQ(MeanPoseError(s.problem, before), 0.0);
   s.problem.poses[0].fixed = true;
   s.problem.observations[0].point_index = s.problem.points.size();
-  EXPECT_THROW(SolveBundle(PinholeCamera(), &s.problem, BundleOptions()), InputError);
+  EXPECT_THROW(SolveBundle(URightCamera(), &s.problem, BundleOptions()), InputError);
   BundleOptions bad;
   bad.max_iterations = 0;
   std::string error;
   EXPECT_FALSE(bad.Check(&error));
-  EXPECT_THROW(SolveBundle(PinholeCamera(), &s.problem, bad), InputError);
+  EXPECT_THROW(SolveBundle(URightCamera(), &s.problem, bad), InputError);
 }
 
 }  // namespace

@@ -1,7 +1,8 @@
 // Ceres reprojection residuals for the RGB-D (virtual stereo) and monocular observation models.
 // Parameter layout: rotation quaternion of cam_from_world in Eigen order [x, y, z, w] (use
 // ceres::EigenQuaternionManifold), translation of cam_from_world [3], point in world [3].
-// Residual = sqrt_info * (projection - observation); sqrt_info = sqrt(inv_sigma2(octave)).
+// Residual = sqrt_info * (projection - observation); sqrt_info = sqrt(inv_sigma2(octave)); the
+// third (depth) residual as in WhitenedStereoResidual (geometry/projection.h).
 #pragma once
 
 #include <ceres/cost_function.h>
@@ -16,7 +17,10 @@ namespace detslam {
 // Intrinsics as the residuals need them.
 struct StereoIntrinsics {
   double fx = 0, fy = 0, cx = 0, cy = 0, bf = 0;
-  static StereoIntrinsics From(const PinholeCamera& c) { return {c.fx, c.fy, c.cx, c.cy, c.bf}; }
+  double disparity_sigma = 0;  // > 0: third residual = disparity error / this (see PinholeCamera)
+  static StereoIntrinsics From(const PinholeCamera& c) {
+    return {c.fx, c.fy, c.cx, c.cy, c.bf, c.disparity_sigma};
+  }
 };
 
 namespace cost_internal {
@@ -37,7 +41,10 @@ void ProjectResidual(const StereoIntrinsics& k, const Eigen::Matrix<T, 3, 1>& p_
   const T u = T(k.fx) * p_cam.x() * inv_z + T(k.cx);
   residual[0] = T(sqrt_info) * (u - T(observed[0]));
   residual[1] = T(sqrt_info) * (T(k.fy) * p_cam.y() * inv_z + T(k.cy) - T(observed[1]));
-  if (stereo) residual[2] = T(sqrt_info) * (u - T(k.bf) * inv_z - T(observed[2]));
+  if (!stereo) return;
+  residual[2] = k.disparity_sigma > 0
+                    ? (T(k.bf) * inv_z - T(observed[0] - observed[2])) / T(k.disparity_sigma)
+                    : T(sqrt_info) * (u - T(k.bf) * inv_z - T(observed[2]));
 }
 
 }  // namespace cost_internal

@@ -4,6 +4,8 @@
 #include <ceres/manifold.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <memory>
 
 namespace detslam {
@@ -58,8 +60,11 @@ TEST(CostFunctionsTest, PoseOnlyResidualsHandMade) {
 }
 
 // Probes the Jacobians (in the quaternion's tangent space) against numeric differentiation at a
-// generic, non-symmetric configuration.
-void ExpectGradientsMatch(const ceres::CostFunction& cost, int num_blocks) {
+// generic, non-symmetric configuration. `exact_zeros`: the residual has Jacobian entries that are
+// exactly zero (where relative errors cannot compare); then every entry must match to 1e-7
+// absolute or relative, whichever is larger.
+void ExpectGradientsMatch(const ceres::CostFunction& cost, int num_blocks,
+                          bool exact_zeros = false) {
   const Eigen::Quaterniond rot =
       Eigen::Quaterniond(Eigen::AngleAxisd(0.4, Eigen::Vector3d(0.3, -0.5, 0.8).normalized()));
   const double q[4] = {rot.x(), rot.y(), rot.z(), rot.w()};
@@ -72,8 +77,23 @@ void ExpectGradientsMatch(const ceres::CostFunction& cost, int num_blocks) {
   ceres::NumericDiffOptions numeric;
   const ceres::GradientChecker checker(&cost, &manifolds, numeric);
   ceres::GradientChecker::ProbeResults results;
-  EXPECT_TRUE(checker.Probe(params, 1e-7, &results)) << results.error_log;
-  EXPECT_LT(results.maximum_relative_error, 1e-7);
+  const bool ok = checker.Probe(params, 1e-7, &results);
+  if (!exact_zeros) {
+    EXPECT_TRUE(ok) << results.error_log;
+    EXPECT_LT(results.maximum_relative_error, 1e-7);
+    return;
+  }
+  ASSERT_EQ(results.local_jacobians.size(), static_cast<size_t>(num_blocks));
+  for (int b = 0; b < num_blocks; ++b) {
+    const auto& user = results.local_jacobians[b];
+    const auto& numeric = results.local_numeric_jacobians[b];
+    for (int i = 0; i < user.rows(); ++i) {
+      for (int j = 0; j < user.cols(); ++j) {
+        EXPECT_NEAR(user(i, j), numeric(i, j), 1e-7 * std::max(1.0, std::abs(numeric(i, j))))
+            << "block " << b << " (" << i << ", " << j << ")";
+      }
+    }
+  }
 }
 
 TEST(CostFunctionsTest, GradientCheckerAcceptsAllResiduals) {
@@ -90,6 +110,23 @@ TEST(CostFunctionsTest, GradientCheckerAcceptsAllResiduals) {
   ExpectGradientsMatch(*c2, 3);
   ExpectGradientsMatch(*c3, 2);
   ExpectGradientsMatch(*c4, 2);
+}
+
+// Disparity model: the third residual is (bf / z - (u_obs - u_right_obs)) / disparity_sigma,
+// independent of sqrt_info: (40 / 2 - (394 - 372)) / 0.25 = -8.
+TEST(CostFunctionsTest, StereoDisparityResidualHandMade) {
+  StereoIntrinsics k = HandIntrinsics();
+  k.disparity_sigma = 0.25;
+  std::unique_ptr<ceres::CostFunction> cost(
+      StereoReprojectionCost::Create(k, Eigen::Vector3d(394, 221, 372), 2.0));
+  const double* params[] = {kQ, kT, kP};
+  double r[3];
+  ASSERT_TRUE(cost->Evaluate(params, r, nullptr));
+  EXPECT_NEAR(r[0], 2.0 * (395 - 394), 1e-12);
+  EXPECT_NEAR(r[1], 2.0 * (220 - 221), 1e-12);
+  EXPECT_NEAR(r[2], (20.0 - 22.0) / 0.25, 1e-12);
+  // The depth does not change under a rotation about the camera's optical axis: an exact zero.
+  ExpectGradientsMatch(*cost, 3, /*exact_zeros=*/true);
 }
 
 }  // namespace

@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "detslam/core/check.h"
+#include "detslam/geometry/projection.h"
 
 namespace detslam {
 namespace {
@@ -19,18 +20,17 @@ struct Observation {
   bool stereo;
   double chi2_threshold;
   double huber_delta;
+  double sqrt_info;  // sqrt of the keypoint octave's information
 };
 
-// Residual (projection - observation) in pixels; false when the point is not in front.
+// Whitened residual (WhitenedStereoResidual; third entry 0 for a mono observation); false when
+// the point is not in front.
 bool Residual(const PinholeCamera& camera, const Observation& o, const Rigid3d& pose,
               Eigen::Vector3d* p_cam, Eigen::Vector3d* r) {
   *p_cam = pose * o.obs->point_world;
   if (p_cam->z() <= kMinDepth) return false;
-  const double inv_z = 1.0 / p_cam->z();
-  const double u = camera.fx * p_cam->x() * inv_z + camera.cx;
-  (*r)(0) = u - o.obs->uv.x();
-  (*r)(1) = camera.fy * p_cam->y() * inv_z + camera.cy - o.obs->uv.y();
-  (*r)(2) = o.stereo ? u - camera.bf * inv_z - o.obs->u_right : 0.0;
+  *r = WhitenedStereoResidual(camera, *p_cam, o.obs->uv, o.obs->u_right, o.sqrt_info);
+  if (!o.stereo) (*r)(2) = 0.0;
   return true;
 }
 
@@ -57,8 +57,7 @@ class PoseProblem {
     for (size_t i = 0; i < obs_.size(); ++i) {
       if (!active[i] || !Residual(camera_, obs_[i], pose, &p_cam, &r)) continue;
       double cost, weight;
-      Robustify(obs_[i].obs->inv_sigma2 * r.squaredNorm(), obs_[i].huber_delta, robust, &cost,
-                &weight);
+      Robustify(r.squaredNorm(), obs_[i].huber_delta, robust, &cost, &weight);
       total += cost;
     }
     return total;
@@ -73,12 +72,15 @@ class PoseProblem {
     Eigen::Vector3d p_cam, r;
     for (size_t i = 0; i < obs_.size(); ++i) {
       if (!active[i] || !Residual(camera_, obs_[i], pose, &p_cam, &r)) continue;
-      const double info = obs_[i].obs->inv_sigma2;
       double cost, weight;
-      Robustify(info * r.squaredNorm(), obs_[i].huber_delta, robust, &cost, &weight);
+      Robustify(r.squaredNorm(), obs_[i].huber_delta, robust, &cost, &weight);
       total += cost;
-      const Eigen::Matrix<double, 3, 6> j = StereoPoseJacobian(camera_, p_cam);
-      const double w = weight * info;
+      // Whitened Jacobian: (u, v) rows times sqrt_info; the disparity bf / z has the Jacobian
+      // d(u)/d(delta) - d(u_right)/d(delta).
+      const Eigen::Matrix<double, 3, 6> jp = StereoPoseJacobian(camera_, p_cam);
+      Eigen::Matrix<double, 3, 6> j = obs_[i].sqrt_info * jp;
+      if (camera_.disparity_sigma > 0) j.row(2) = (jp.row(0) - jp.row(2)) / camera_.disparity_sigma;
+      const double w = weight;
       if (obs_[i].stereo) {
         h->noalias() += w * j.transpose() * j;
         g->noalias() += w * j.transpose() * r;
@@ -125,7 +127,7 @@ class PoseProblem {
     Eigen::Vector3d p_cam, r;
     for (size_t i = 0; i < obs_.size(); ++i) {
       const bool ok = Residual(camera_, obs_[i], pose, &p_cam, &r) &&
-                      obs_[i].obs->inv_sigma2 * r.squaredNorm() <= obs_[i].chi2_threshold;
+                      r.squaredNorm() <= obs_[i].chi2_threshold;
       (*inliers)[i] = ok;
       count += ok ? 1 : 0;
     }
@@ -172,7 +174,7 @@ PoseOptimizerResult OptimizePose(const PinholeCamera& camera, const Rigid3d& ini
   for (const PoseObservation& o : observations) {
     const bool stereo = o.u_right >= 0.0;
     const double chi2 = stereo ? options.chi2_stereo : options.chi2_mono;
-    obs.push_back({&o, stereo, chi2, std::sqrt(chi2)});
+    obs.push_back({&o, stereo, chi2, std::sqrt(chi2), std::sqrt(o.inv_sigma2)});
   }
   const PoseProblem problem(camera, std::move(obs));
   PoseOptimizerResult result;

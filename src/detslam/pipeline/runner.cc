@@ -44,7 +44,8 @@ void WriteOutputs(const RgbdDataset& dataset, const Settings& settings, const Ru
   j["mode"] = options.threaded ? (options.slam.mapping_thread ? "threaded (mapping thread)" : "threaded") : "sequential";
   j["camera"] = {{"fx", settings.camera.fx}, {"fy", settings.camera.fy}, {"cx", settings.camera.cx},
                  {"cy", settings.camera.cy}, {"depth_map_factor", settings.camera.depth_map_factor},
-                 {"bf", settings.camera.bf}, {"th_depth", settings.camera.th_depth}};
+                 {"bf", settings.camera.bf}, {"th_depth", settings.camera.th_depth},
+                 {"disparity_sigma", settings.camera.disparity_sigma}};
   j["orb"] = {{"num_features", options.slam.orb.num_features}, {"scale_factor", options.slam.orb.scale_factor},
               {"num_levels", options.slam.orb.num_levels}, {"ini_th_fast", options.slam.orb.ini_th_fast},
               {"min_th_fast", options.slam.orb.min_th_fast}};
