@@ -397,6 +397,16 @@ void ApplySettingOverrides(const std::vector<std::string>& overrides, Settings* 
       throw InputError("--set " + o + ": expected KEY=VALUE, e.g. --set Dynamic.Alpha=0.2");
     }
     const std::string key = o.substr(0, eq);
+    if (key == "RGBD.DisparitySigma") {  // a weighting of the depth, not a calibration
+      char* end = nullptr;
+      const std::string value = o.substr(eq + 1);
+      const double sigma = std::strtod(value.c_str(), &end);
+      if (end == value.c_str() || *end != '\0' || !(sigma >= 0)) {
+        throw InputError("--set " + o + ": RGBD.DisparitySigma must be a number >= 0");
+      }
+      settings->camera.disparity_sigma = sigma;
+      continue;
+    }
     for (const char* typed : {"Camera", "Camera1.", "Camera.", "Stereo.", "RGBD.", "ORBextractor."}) {
       if (key.rfind(typed, 0) == 0) {
         throw InputError("--set " + o + ": camera and ORB keys come from the settings file (--config)");

@@ -258,7 +258,12 @@ TEST_F(SettingsTest, OverridesSetKeysAndAreNamedInTheSource) {
   } catch (const InputError& e) {
     EXPECT_THAT(e.what(), HasSubstr("--set Tracking.X=abc"));
   }
-  for (const std::string bad : {"NoValue", "=1", "Key=", "Camera.fx=500", "ORBextractor.nFeatures=10"}) {
+  // The depth weighting is the one camera-section key that --set may change.
+  ApplySettingOverrides({"RGBD.DisparitySigma=0"}, &s);
+  EXPECT_DOUBLE_EQ(s.camera.disparity_sigma, 0.0);
+  for (const std::string bad : {"NoValue", "=1", "Key=", "Camera.fx=500", "ORBextractor.nFeatures=10",
+                                "RGBD.DisparitySigma=-1", "RGBD.DisparitySigma=x",
+                                "RGBD.DepthMapFactor=1000"}) {
     Settings t;
     EXPECT_THROW(ApplySettingOverrides({bad}, &t), InputError) << bad;
   }
