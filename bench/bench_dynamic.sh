@@ -8,6 +8,7 @@
 #   masks + depth step (dnn)           : the Det-SLAM filter, no geometric check
 #   + geometric check (default)        : the filter and the tracker's geometric check
 #   gt masks (+ depth step, geometric) : oracle segmentation from the generator
+#   twin and filter, RGBD.DisparitySigma=0: the same with ORB-SLAM3's depth weighting
 # The dnn masks are computed once per sequence with `detslam segment` and replayed (masks:DIR),
 # which gives the same result as --segmenter dnn. The (preset, seed) jobs run JOBS at a time
 # (sequential-mode runs are deterministic, so their accuracy does not depend on the load). Then,
@@ -66,6 +67,10 @@ job() {
   read -r depth depth_tr < <(run_eval "$seq" "$seq.depth" --segmenter "masks:$seq.dnnmasks" --no-geometric-check)
   read -r full full_tr < <(run_eval "$seq" "$seq.full" --segmenter "masks:$seq.dnnmasks")
   read -r gt gt_tr < <(run_eval "$seq" "$seq.gt" --segmenter gt)
+  # The twin and the default filter with ORB-SLAM3's depth weighting (u_right residual).
+  local twin0 full0
+  read -r twin0 _ < <(run_eval "$seq.twin" "$seq.twin.run0" --segmenter none --set RGBD.DisparitySigma=0)
+  read -r full0 _ < <(run_eval "$seq" "$seq.full0" --segmenter "masks:$seq.dnnmasks" --set RGBD.DisparitySigma=0)
   python3 - "$preset" "$seed" "$twin" "$twin_tr" "$full" "$full_tr" "$none" "$none_tr" "$seq.full/run.json" \
       >"$work/rows/${preset}_$seed.main" <<'PY'
 import json, sys
@@ -77,8 +82,8 @@ tr, n = full_tr.split("/")
 ok = "yes" if ratio <= 1.25 and tr == n else "no"
 print(f"| {preset} | {seed} | {float(twin):.1f} ({twin_tr}) | {float(full):.1f} ({full_tr}) | {ratio:.2f} | {ok} | {float(none):.1f} ({none_tr}) | {cov:.0f} |")
 PY
-  printf '| %s | %s | %.1f | %.1f | %.1f | %.1f | %.1f | %.1f |\n' "$preset" "$seed" "$twin" "$none" "$mask" "$depth" "$full" "$gt" \
-      >"$work/rows/${preset}_$seed.ablation"
+  printf '| %s | %s | %.1f | %.1f | %.1f | %.1f | %.1f | %.1f | %.1f / %.1f (%.2f) |\n' "$preset" "$seed" "$twin" "$none" "$mask" "$depth" "$full" "$gt" \
+      "$twin0" "$full0" "$(python3 -c "print($full0 / $twin0)")" >"$work/rows/${preset}_$seed.ablation"
   if [[ " $spread_presets " == *" $preset "* ]]; then
     # Spread: the same twin and filtered runs with the keyframe far-point budget moved by +-20
     # (Tracking.KeyFrameFarPoints 280 / 320 around the default 300), a change with no bearing on
@@ -181,10 +186,12 @@ done
   echo
   echo "Ablation (ATE RMSE mm). \"+ geometric check\" adds the tracker's check for movers the segmenter"
   echo "missed (on by default; \`--no-geometric-check\` turns it off); the two columns before it run"
-  echo "without it. gt masks: the generator's masks with the default filter."
+  echo "without it. gt masks: the generator's masks with the default filter. Last column: the static"
+  echo "twin and the default filter with ORB-SLAM3's depth weighting (\`--set RGBD.DisparitySigma=0\`:"
+  echo "u_right residual with the keypoint's sigma), and their ratio."
   echo
-  echo "| preset | seed | static twin | none | masks only | masks + depth step | + geometric check (default) | gt masks |"
-  echo "|---|---:|---:|---:|---:|---:|---:|---:|"
+  echo "| preset | seed | static twin | none | masks only | masks + depth step | + geometric check (default) | gt masks | twin / filter, ORB-SLAM3 depth weighting (ratio) |"
+  echo "|---|---:|---:|---:|---:|---:|---:|---:|---:|"
   printf '%s\n' "$ablation_rows"
   echo
   if [[ -n "$spread_rows" ]]; then

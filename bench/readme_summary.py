@@ -52,19 +52,21 @@ def summary(bench_text):
     rows = []
     slam = section(bench_text, "slam")
     if slam:
-        for table in tables(slam):
+        # The run tables (the depth-weighting table has one ATE column per setting instead).
+        run_tables = [t for t in tables(slam) if t and "ATE RMSE mm" in t[0]]
+        for table in run_tables:
             for r in table:
                 seq = r.get("sequence", "")
                 if seq.startswith("fr2/desk"):
                     rows.append(("SLAM core, real TUM fr2/desk (50 frames)", f"{r['tracked']} tracked",
                                  f"ATE RMSE {r['ATE RMSE mm']} mm (ORB-SLAM3: 7.0-8.1 mm)"))
-        static = [r for t in tables(slam) for r in t if r.get("sequence", "").startswith("static")]
+        static = [r for t in run_tables for r in t if r.get("sequence", "").startswith("static")]
         if static:
             ates = [number(r["ATE RMSE mm"]) for r in static]
             tracked = "all frames tracked" if all(r["tracked"].split("/")[0] == r["tracked"].split("/")[1] for r in static) else "NOT all tracked"
             rows.append((f"SLAM core, synthetic static ({len(static)} seeds)", tracked,
                          f"ATE RMSE {min(ates):.1f}-{max(ates):.1f} mm"))
-        loops = {r["sequence"]: r for t in tables(slam) for r in t if r.get("sequence", "").startswith("loop")}
+        loops = {r["sequence"]: r for t in run_tables for r in t if r.get("sequence", "").startswith("loop")}
         drift = dict(re.findall(r"End drift, loop closing (on|off): ([0-9.]+ cm over a [0-9.]+ m path \([0-9.]+ %\))", slam))
         for name, r in loops.items():
             mode = "on" if "closing on" in name else "off"
