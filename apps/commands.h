@@ -19,5 +19,6 @@ void AddEvalCommand(CLI::App& app);
 void AddSynthCommand(CLI::App& app);
 void AddRunCommand(CLI::App& app);
 void AddSegmentCommand(CLI::App& app);
+void AddReportCommand(CLI::App& app);
 
 }  // namespace detslam::app

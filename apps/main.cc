@@ -1,4 +1,4 @@
-// The `detslam` command: subcommands run, eval, synth (see --help).
+// The `detslam` command: subcommands run, eval, synth, segment, report (see --help).
 #include <spdlog/spdlog.h>
 
 #include <exception>
@@ -19,6 +19,7 @@ int main(int argc, char** argv) {
   detslam::app::AddEvalCommand(app);
   detslam::app::AddSynthCommand(app);
   detslam::app::AddSegmentCommand(app);
+  detslam::app::AddReportCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

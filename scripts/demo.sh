@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Quick start: installs what is missing (Debian 12), builds detslam in Release, generates a
 # synthetic dynamic RGB-D sequence (people walking through an office, with ground truth) and its
-# static twin, runs SLAM on both, evaluates them like the TUM tools and prints where everything is.
+# static twin, runs SLAM on both, evaluates them like the TUM tools, writes an HTML report of each
+# run and prints where everything is.
 # Usage: scripts/demo.sh [FRAMES]   (default 300; outputs in demo_out/)
 set -euo pipefail
 ROOT=$(cd "$(dirname "$0")/.." && pwd)
@@ -32,6 +33,7 @@ run() {  # name dataset segmenter
   echo "== 3/3 evaluation: $1 (TUM conventions: 0.02 s association, SE(3) alignment, RPE over 1 s)"
   "$DETSLAM" eval --gt "$OUT/$2/groundtruth.txt" --est "$OUT/$1/trajectory.txt" --frames "$OUT/$2" \
     --json "$OUT/$1/eval.json" --plot "$OUT/$1/eval.svg"
+  "$DETSLAM" report --run "$OUT/$1"
 }
 run static_twin walking_xyz_static_twin none
 run people_no_filter walking_xyz none
@@ -42,4 +44,5 @@ for r in static_twin people_no_filter "people_detslam_$FILTER"; do
   python3 -c "import json,sys; e=json.load(open(sys.argv[2])); print(f'  {sys.argv[1]:<26} ATE RMSE {e[\"ate\"][\"rmse\"]*1000:7.1f} mm, tracked {e[\"coverage\"][\"fraction\"]*100:5.1f} %')" "$r" "$OUT/$r/eval.json"
 done
 echo "Outputs under $OUT/: <run>/trajectory.txt (TUM), keyframes.txt, map.ply, run.json,"
-echo "eval.json and eval.svg (trajectory and error plots; open the SVG in a browser)."
+echo "eval.json, eval.svg (trajectory and error plots) and report.html (the run with its plots;"
+echo "open it in a browser)."

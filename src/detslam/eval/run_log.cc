@@ -1,0 +1,83 @@
+#include "detslam/eval/run_log.h"
+
+#include <algorithm>
+#include <fstream>
+#include <iterator>
+#include <nlohmann/json.hpp>
+
+#include "detslam/core/check.h"
+
+namespace detslam {
+namespace {
+
+using nlohmann::json;
+
+// Value of `key` in `j` as T; a missing or mistyped key is an InputError naming `where`.
+template <typename T>
+T Get(const json& j, const char* key, const std::string& path, const std::string& where) {
+  const auto it = j.find(key);
+  if (it == j.end()) throw InputError(path, 0, where + "missing key '" + key + "'");
+  try {
+    return it->get<T>();
+  } catch (const json::exception&) {
+    throw InputError(path, 0, where + "key '" + key + "' has the wrong type");
+  }
+}
+
+}  // namespace
+
+RunLog ReadRunLog(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(path, 0, "cannot open run log (run.json of a `detslam run` output folder)");
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  json j;
+  try {
+    j = json::parse(text);
+  } catch (const json::parse_error& e) {
+    const size_t at = std::min(e.byte, text.size());
+    const int line = 1 + static_cast<int>(std::count(text.begin(), text.begin() + static_cast<std::ptrdiff_t>(at), '\n'));
+    throw InputError(path, line, std::string("not valid JSON: ") + e.what());
+  }
+  if (!j.is_object()) throw InputError(path, 0, "run log must be a JSON object");
+  RunLog r;
+  r.path = path;
+  r.dataset = Get<std::string>(j, "dataset", path, "");
+  r.settings = Get<std::string>(j, "settings", path, "");
+  r.mode = Get<std::string>(j, "mode", path, "");
+  r.segmenter = Get<std::string>(j, "segmenter", path, "");
+  r.frames = Get<int64_t>(j, "frames", path, "");
+  r.frames_tracked = Get<int64_t>(j, "frames_tracked", path, "");
+  r.keyframes = Get<int64_t>(j, "keyframes", path, "");
+  r.map_points = Get<int64_t>(j, "map_points", path, "");
+  r.relocalizations = Get<int64_t>(j, "relocalizations", path, "");
+  r.loops_closed = Get<int64_t>(j, "loops_closed", path, "");
+  r.wall_s = Get<double>(j, "wall_s", path, "");
+  const json frames = Get<json>(j, "per_frame", path, "");
+  if (!frames.is_array()) throw InputError(path, 0, "key 'per_frame' must be an array");
+  for (size_t k = 0; k < frames.size(); ++k) {
+    const json& f = frames[k];
+    const std::string where = "per_frame[" + std::to_string(k) + "]: ";
+    if (!f.is_object()) throw InputError(path, 0, where + "must be an object");
+    RunFrameLog l;
+    l.index = Get<int64_t>(f, "index", path, where);
+    l.stamp = Get<double>(f, "stamp", path, where);
+    l.state = Get<std::string>(f, "state", path, where);
+    l.tracked = Get<bool>(f, "tracked", path, where);
+    l.method = Get<std::string>(f, "method", path, where);
+    l.inliers = Get<int>(f, "inliers", path, where);
+    l.keyframe = Get<bool>(f, "keyframe", path, where);
+    l.loop_closed = Get<bool>(f, "loop_closed", path, where);
+    l.keypoints = Get<int>(f, "keypoints", path, where);
+    l.dynamic_instances = Get<int>(f, "dynamic_instances", path, where);
+    l.rejected_keypoints = Get<int>(f, "rejected_keypoints", path, where);
+    l.geometric_rejected = Get<int>(f, "geometric_rejected", path, where);
+    l.segmentation_ms = Get<double>(f, "segmentation_ms", path, where);
+    l.extraction_ms = Get<double>(f, "extraction_ms", path, where);
+    l.tracking_ms = Get<double>(f, "tracking_ms", path, where);
+    l.mapping_ms = Get<double>(f, "mapping_ms", path, where);
+    r.per_frame.push_back(std::move(l));
+  }
+  return r;
+}
+
+}  // namespace detslam

@@ -1,0 +1,43 @@
+// What `detslam report` reads back from a `detslam run` output folder: run.json (settings,
+// counts, per-stage timings and the per-frame log written by pipeline/runner.cc).
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace detslam {
+
+struct RunFrameLog {
+  int64_t index = 0;
+  double stamp = 0;            // colour image stamp (seconds)
+  std::string state;           // tracking state after the frame ("OK", "LOST", ...)
+  bool tracked = false;        // the frame has a pose
+  std::string method;          // how it was tracked ("motion", "reference", ...)
+  int inliers = 0;             // landmark inliers after local-map tracking
+  bool keyframe = false;
+  bool loop_closed = false;
+  int keypoints = 0;           // keypoints used for tracking
+  int dynamic_instances = 0;   // dynamic objects the segmenter reported
+  int rejected_keypoints = 0;  // keypoints the dynamic filter rejected
+  int geometric_rejected = 0;  // keypoints the geometric check labelled
+  double segmentation_ms = 0, extraction_ms = 0, tracking_ms = 0, mapping_ms = 0;
+};
+
+struct RunLog {
+  std::string path;  // the run.json read
+  std::string dataset, settings, mode, segmenter;
+  int64_t frames = 0, frames_tracked = 0, keyframes = 0, map_points = 0;
+  int64_t relocalizations = 0, loops_closed = 0;
+  double wall_s = 0;
+  std::vector<RunFrameLog> per_frame;
+
+  double TrackedFraction() const { return frames > 0 ? static_cast<double>(frames_tracked) / frames : 0.0; }
+  double FramesPerSecond() const { return wall_s > 0 ? frames / wall_s : 0.0; }
+};
+
+// Reads run.json. Throws InputError naming the file (and the line of a JSON syntax error, or the
+// missing or mistyped key).
+RunLog ReadRunLog(const std::string& path);
+
+}  // namespace detslam

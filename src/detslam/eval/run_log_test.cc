@@ -1,0 +1,108 @@
+#include "detslam/eval/run_log.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "detslam/core/check.h"
+
+namespace detslam {
+namespace {
+
+namespace fs = std::filesystem;
+using ::testing::HasSubstr;
+using ::testing::StartsWith;
+
+constexpr const char* kFrame =
+    R"({"index": 1, "stamp": 12.5, "state": "OK", "tracked": true, "method": "motion",
+        "inliers": 321, "keyframe": false, "loop_closed": true, "keypoints": 998,
+        "dynamic_instances": 2, "rejected_keypoints": 77, "geometric_rejected": 4,
+        "segmentation_ms": 41.5, "extraction_ms": 8.25, "tracking_ms": 3.5, "mapping_ms": 0.0})";
+
+std::string RunJson(const std::string& frames) {
+  return std::string(R"({
+ "dataset": "/data/walking", "settings": "settings.yaml", "mode": "threaded",
+ "segmenter": "dnn:yolox_nano.onnx", "frames": 2, "frames_tracked": 1, "keyframes": 1,
+ "map_points": 640, "relocalizations": 0, "loops_closed": 1, "wall_s": 0.5,
+ "per_frame": [)") + frames + "]}\n";
+}
+
+class RunLogTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::path(::testing::TempDir()) / ("detslam_run_log_" + std::to_string(::getpid()));
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  std::string Write(const std::string& text) {
+    const std::string path = (dir_ / "run.json").string();
+    std::ofstream(path) << text;
+    return path;
+  }
+  std::string Error(const std::string& path) {
+    try {
+      ReadRunLog(path);
+    } catch (const InputError& e) {
+      return e.what();
+    }
+    ADD_FAILURE() << "no InputError for " << path;
+    return "";
+  }
+  fs::path dir_;
+};
+
+TEST_F(RunLogTest, ReadsCountsAndFrames) {
+  const std::string path = Write(RunJson(std::string(kFrame) + ", " + kFrame));
+  const RunLog r = ReadRunLog(path);
+  EXPECT_EQ(r.path, path);
+  EXPECT_EQ(r.dataset, "/data/walking");
+  EXPECT_EQ(r.mode, "threaded");
+  EXPECT_EQ(r.segmenter, "dnn:yolox_nano.onnx");
+  EXPECT_EQ(r.frames, 2);
+  EXPECT_EQ(r.frames_tracked, 1);
+  EXPECT_EQ(r.map_points, 640);
+  EXPECT_EQ(r.loops_closed, 1);
+  EXPECT_DOUBLE_EQ(r.TrackedFraction(), 0.5);
+  EXPECT_DOUBLE_EQ(r.FramesPerSecond(), 4.0);
+  ASSERT_EQ(r.per_frame.size(), 2u);
+  const RunFrameLog& f = r.per_frame[1];
+  EXPECT_EQ(f.index, 1);
+  EXPECT_DOUBLE_EQ(f.stamp, 12.5);
+  EXPECT_EQ(f.state, "OK");
+  EXPECT_TRUE(f.tracked);
+  EXPECT_EQ(f.method, "motion");
+  EXPECT_EQ(f.inliers, 321);
+  EXPECT_FALSE(f.keyframe);
+  EXPECT_TRUE(f.loop_closed);
+  EXPECT_EQ(f.keypoints, 998);
+  EXPECT_EQ(f.dynamic_instances, 2);
+  EXPECT_EQ(f.rejected_keypoints, 77);
+  EXPECT_EQ(f.geometric_rejected, 4);
+  EXPECT_DOUBLE_EQ(f.segmentation_ms, 41.5);
+  EXPECT_DOUBLE_EQ(f.extraction_ms, 8.25);
+  EXPECT_DOUBLE_EQ(f.tracking_ms, 3.5);
+}
+
+TEST_F(RunLogTest, BadInputNamesTheFileLineAndKey) {
+  EXPECT_THAT(Error((dir_ / "missing.json").string()), HasSubstr("cannot open run log"));
+  // A syntax error on line 3.
+  std::string path = Write("{\n \"dataset\": \"x\",\n \"mode\" \"threaded\"\n}\n");
+  std::string e = Error(path);
+  EXPECT_THAT(e, StartsWith(path + ":3: not valid JSON"));
+  std::string text = RunJson(kFrame);
+  text.replace(text.find("\"frames\": 2,"), 12, "");
+  e = Error(Write(text));
+  EXPECT_THAT(e, StartsWith(path + ": "));
+  EXPECT_THAT(e, HasSubstr("missing key 'frames'"));
+  std::string frame = kFrame;
+  frame.replace(frame.find("\"tracked\": true"), 15, "\"tracked\": \"yes\"");
+  EXPECT_THAT(Error(Write(RunJson(std::string(kFrame) + ", " + frame))),
+              HasSubstr("per_frame[1]: key 'tracked' has the wrong type"));
+  EXPECT_THAT(Error(Write("[1, 2]")), HasSubstr("must be a JSON object"));
+}
+
+}  // namespace
+}  // namespace detslam
