@@ -28,10 +28,12 @@ void AddReportCommand(CLI::App& app) {
   auto* cmd = app.add_subcommand(
       "report", "HTML report (self-contained, inline SVG plots) of a `detslam run` output folder");
   auto args = std::make_shared<ReportArgs>();
-  cmd->add_option("--run", args->run, "Output folder of `detslam run` (holds run.json, trajectory.txt)")
+  cmd->add_option("--run", args->run,
+                  "Output folder of `detslam run` (holds run.json, trajectory.txt)")
       ->required();
-  cmd->add_option("--gt", args->gt,
-                  "Ground truth, TUM format (default: groundtruth.txt of the run's dataset, if any)");
+  cmd->add_option(
+      "--gt", args->gt,
+      "Ground truth, TUM format (default: groundtruth.txt of the run's dataset, if any)");
   cmd->add_option("--frames", args->frames,
                   "rgb.txt or dataset folder for the tracked fraction (default: the run's dataset "
                   "when the ground truth is its own)");
@@ -43,7 +45,8 @@ void AddReportCommand(CLI::App& app) {
   cmd->callback([args] {
     namespace fs = std::filesystem;
     const fs::path run_dir(args->run);
-    if (!fs::is_directory(run_dir)) throw InputError(args->run, 0, "not a folder (expected a `detslam run --out` folder)");
+    if (!fs::is_directory(run_dir))
+      throw InputError(args->run, 0, "not a folder (expected a `detslam run --out` folder)");
     const RunLog run = ReadRunLog((run_dir / "run.json").string());
     std::string why;
     if (!args->options.Check(&why)) throw InputError("detslam report: " + why);
@@ -52,7 +55,8 @@ void AddReportCommand(CLI::App& app) {
       const fs::path own = fs::path(run.dataset) / "groundtruth.txt";
       if (fs::is_regular_file(own)) {
         gt = own.string();
-        if (frames.empty() && fs::is_regular_file(fs::path(run.dataset) / "rgb.txt")) frames = run.dataset;
+        if (frames.empty() && fs::is_regular_file(fs::path(run.dataset) / "rgb.txt"))
+          frames = run.dataset;
       } else {
         spdlog::info("no ground truth at {} (pass --gt FILE): the report has no accuracy section",
                      own.string());

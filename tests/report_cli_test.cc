@@ -15,7 +15,8 @@ using ::testing::HasSubstr;
 
 // Runs the CLI with `args`, stdout and stderr into `log`; returns the exit status.
 int Cli(const std::string& args, const fs::path& log) {
-  const std::string cmd = std::string(DETSLAM_CLI_PATH) + " " + args + " > '" + log.string() + "' 2>&1";
+  const std::string cmd =
+      std::string(DETSLAM_CLI_PATH) + " " + args + " > '" + log.string() + "' 2>&1";
   const int status = std::system(cmd.c_str());
   return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
@@ -30,8 +31,14 @@ TEST(IntegrationReport, RunThenReportWithAccuracyAndPerFramePlots) {
   fs::remove_all(dir);
   fs::create_directories(dir);
   const fs::path seq = dir / "seq", out = dir / "out", log = dir / "log.txt";
-  ASSERT_EQ(Cli("synth --preset walking_xyz --seed 1 --frames 40 --out '" + seq.string() + "'", log), 0) << Read(log);
-  ASSERT_EQ(Cli("run --dataset '" + seq.string() + "' --segmenter gt --no-progress --out '" + out.string() + "'", log), 0) << Read(log);
+  ASSERT_EQ(
+      Cli("synth --preset walking_xyz --seed 1 --frames 40 --out '" + seq.string() + "'", log), 0)
+      << Read(log);
+  ASSERT_EQ(Cli("run --dataset '" + seq.string() + "' --segmenter gt --no-progress --out '" +
+                    out.string() + "'",
+                log),
+            0)
+      << Read(log);
   ASSERT_EQ(Cli("report --run '" + out.string() + "'", log), 0) << Read(log);
   EXPECT_THAT(Read(log), HasSubstr("report: " + (out / "report.html").string()));
   const std::string html = Read(out / "report.html");
@@ -42,7 +49,10 @@ TEST(IntegrationReport, RunThenReportWithAccuracyAndPerFramePlots) {
   EXPECT_THAT(html, HasSubstr("segmenter</th><td>gt"));
 
   // Without ground truth (--no-eval) and to another file.
-  ASSERT_EQ(Cli("report --no-eval --run '" + out.string() + "' --out '" + (dir / "r2.html").string() + "'", log), 0);
+  ASSERT_EQ(Cli("report --no-eval --run '" + out.string() + "' --out '" +
+                    (dir / "r2.html").string() + "'",
+                log),
+            0);
   EXPECT_THAT(Read(dir / "r2.html"), HasSubstr("No ground truth given"));
 
   // Bad input: a clear error naming the file, exit 1, no report written.
@@ -51,7 +61,8 @@ TEST(IntegrationReport, RunThenReportWithAccuracyAndPerFramePlots) {
   fs::create_directories(dir / "broken");
   std::ofstream(dir / "broken" / "run.json") << "{\"dataset\": 1}\n";
   EXPECT_EQ(Cli("report --run '" + (dir / "broken").string() + "'", log), 1);
-  EXPECT_THAT(Read(log), HasSubstr((dir / "broken" / "run.json").string() + ": key 'dataset' has the wrong type"));
+  EXPECT_THAT(Read(log), HasSubstr((dir / "broken" / "run.json").string() +
+                                   ": key 'dataset' has the wrong type"));
   EXPECT_FALSE(fs::exists(dir / "broken" / "report.html"));
   fs::remove_all(dir);
 }

@@ -28,14 +28,16 @@ T Get(const json& j, const char* key, const std::string& path, const std::string
 
 RunLog ReadRunLog(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path, 0, "cannot open run log (run.json of a `detslam run` output folder)");
+  if (!in)
+    throw InputError(path, 0, "cannot open run log (run.json of a `detslam run` output folder)");
   const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   json j;
   try {
     j = json::parse(text);
   } catch (const json::parse_error& e) {
     const size_t at = std::min(e.byte, text.size());
-    const int line = 1 + static_cast<int>(std::count(text.begin(), text.begin() + static_cast<std::ptrdiff_t>(at), '\n'));
+    const int line = 1 + static_cast<int>(std::count(
+                             text.begin(), text.begin() + static_cast<std::ptrdiff_t>(at), '\n'));
     throw InputError(path, line, std::string("not valid JSON: ") + e.what());
   }
   if (!j.is_object()) throw InputError(path, 0, "run log must be a JSON object");

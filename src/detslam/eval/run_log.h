@@ -10,11 +10,11 @@ namespace detslam {
 
 struct RunFrameLog {
   int64_t index = 0;
-  double stamp = 0;            // colour image stamp (seconds)
-  std::string state;           // tracking state after the frame ("OK", "LOST", ...)
-  bool tracked = false;        // the frame has a pose
-  std::string method;          // how it was tracked ("motion", "reference", ...)
-  int inliers = 0;             // landmark inliers after local-map tracking
+  double stamp = 0;      // colour image stamp (seconds)
+  std::string state;     // tracking state after the frame ("OK", "LOST", ...)
+  bool tracked = false;  // the frame has a pose
+  std::string method;    // how it was tracked ("motion", "reference", ...)
+  int inliers = 0;       // landmark inliers after local-map tracking
   bool keyframe = false;
   bool loop_closed = false;
   int keypoints = 0;           // keypoints used for tracking
@@ -32,7 +32,9 @@ struct RunLog {
   double wall_s = 0;
   std::vector<RunFrameLog> per_frame;
 
-  double TrackedFraction() const { return frames > 0 ? static_cast<double>(frames_tracked) / frames : 0.0; }
+  double TrackedFraction() const {
+    return frames > 0 ? static_cast<double>(frames_tracked) / frames : 0.0;
+  }
   double FramesPerSecond() const { return wall_s > 0 ? frames / wall_s : 0.0; }
 };
 

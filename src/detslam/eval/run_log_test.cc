@@ -27,7 +27,8 @@ std::string RunJson(const std::string& frames) {
  "dataset": "/data/walking", "settings": "settings.yaml", "mode": "threaded",
  "segmenter": "dnn:yolox_nano.onnx", "frames": 2, "frames_tracked": 1, "keyframes": 1,
  "map_points": 640, "relocalizations": 0, "loops_closed": 1, "wall_s": 0.5,
- "per_frame": [)") + frames + "]}\n";
+ "per_frame": [)") +
+         frames + "]}\n";
 }
 
 class RunLogTest : public ::testing::Test {

@@ -11,17 +11,6 @@
 #include "detslam/eval/svg_plot.h"
 
 namespace detslam {
-
-using svg::Axes;
-using svg::Escape;
-using svg::Label;
-using svg::Legend;
-using svg::NiceStep;
-using svg::Num;
-using svg::Panel;
-using svg::Polyline;
-using svg::Range;
-
 namespace {
 
 constexpr const char* kBlue = "#1f77b4";
@@ -35,7 +24,7 @@ using Series = std::vector<std::pair<double, double>>;
 
 // One line of `value(frame)` over the frame index in panel `p`, against range `r`.
 template <typename Fn>
-Series Line(const RunLog& run, const Panel& p, const Range& r, Fn value) {
+Series Line(const RunLog& run, const svg::Panel& p, const svg::Range& r, Fn value) {
   Series s;
   for (const RunFrameLog& f : run.per_frame) {
     s.emplace_back(p.X(static_cast<double>(f.index)), p.Y2(value(f), r));
@@ -44,7 +33,7 @@ Series Line(const RunLog& run, const Panel& p, const Range& r, Fn value) {
 }
 
 // Shades runs of frames without a pose.
-void ShadeLost(std::ostringstream& os, const RunLog& run, const Panel& p) {
+void ShadeLost(std::ostringstream& os, const RunLog& run, const svg::Panel& p) {
   const auto& fr = run.per_frame;
   for (size_t k = 0; k < fr.size(); ++k) {
     if (fr[k].tracked) continue;
@@ -52,28 +41,30 @@ void ShadeLost(std::ostringstream& os, const RunLog& run, const Panel& p) {
     while (end + 1 < fr.size() && !fr[end + 1].tracked) ++end;
     const double a = p.X(static_cast<double>(fr[k].index) - 0.5);
     const double b = p.X(static_cast<double>(fr[end].index) + 0.5);
-    os << "<rect x='" << Num(a) << "' y='" << Num(p.y) << "' width='" << Num(std::max(1.0, b - a))
-       << "' height='" << Num(p.h) << "' fill='#ff9896' fill-opacity='0.35'/>\n";
+    os << "<rect x='" << svg::Num(a) << "' y='" << svg::Num(p.y) << "' width='"
+       << svg::Num(std::max(1.0, b - a)) << "' height='" << svg::Num(p.h)
+       << "' fill='#ff9896' fill-opacity='0.35'/>\n";
     k = end;
   }
 }
 
 // Right-hand axis labels for range `r`.
-void RightAxis(std::ostringstream& os, const Panel& p, const Range& r, const std::string& label,
-               const char* color) {
-  const double step = NiceStep(r.hi - r.lo, 4);
+void RightAxis(std::ostringstream& os, const svg::Panel& p, const svg::Range& r,
+               const std::string& label, const char* color) {
+  const double step = svg::NiceStep(r.hi - r.lo, 4);
   for (double v = 0; v <= r.hi + 1e-9 * step; v += step) {
-    os << "<text x='" << Num(p.x + p.w + 6) << "' y='" << Num(p.Y2(v, r) + 4) << "' fill='"
-       << color << "'>" << Label(v) << "</text>\n";
+    os << "<text x='" << svg::Num(p.x + p.w + 6) << "' y='" << svg::Num(p.Y2(v, r) + 4)
+       << "' fill='" << color << "'>" << svg::Label(v) << "</text>\n";
   }
-  os << "<text transform='translate(" << Num(p.x + p.w + 44) << "," << Num(p.y + p.h / 2)
-     << ") rotate(90)' text-anchor='middle' fill='" << color << "'>" << Escape(label) << "</text>\n";
+  os << "<text transform='translate(" << svg::Num(p.x + p.w + 44) << "," << svg::Num(p.y + p.h / 2)
+     << ") rotate(90)' text-anchor='middle' fill='" << color << "'>" << svg::Escape(label)
+     << "</text>\n";
 }
 
-Range MaxRange(const RunLog& run, double (*value)(const RunFrameLog&)) {
+svg::Range MaxRange(const RunLog& run, double (*value)(const RunFrameLog&)) {
   std::vector<double> v;
   for (const RunFrameLog& f : run.per_frame) v.push_back(value(f));
-  Range r = Range::Of(v, true);
+  svg::Range r = svg::Range::Of(v, true);
   r.hi *= 1.08;
   return r;
 }
@@ -95,7 +86,7 @@ size_t LongestLost(const RunLog& run) {
 }
 
 std::string TableRow(const std::string& key, const std::string& value) {
-  return "<tr><th>" + Escape(key) + "</th><td>" + Escape(value) + "</td></tr>\n";
+  return "<tr><th>" + svg::Escape(key) + "</th><td>" + svg::Escape(value) + "</td></tr>\n";
 }
 
 }  // namespace
@@ -104,63 +95,95 @@ std::string RenderRunSvg(const RunLog& run) {
   constexpr double kW = 960, kH = 860;
   std::vector<double> idx;
   for (const RunFrameLog& f : run.per_frame) idx.push_back(static_cast<double>(f.index));
-  Range frames = Range::Of(idx, true);
-  const Range track_r = MaxRange(run, [](const RunFrameLog& f) { return static_cast<double>(std::max(f.keypoints, f.inliers)); });
-  const Range dyn_r = MaxRange(run, [](const RunFrameLog& f) { return static_cast<double>(std::max(f.rejected_keypoints, f.geometric_rejected)); });
-  const Range inst_r = MaxRange(run, [](const RunFrameLog& f) { return static_cast<double>(f.dynamic_instances); });
-  const Range time_r = MaxRange(run, [](const RunFrameLog& f) {
+  svg::Range frames = svg::Range::Of(idx, true);
+  const svg::Range track_r = MaxRange(run, [](const RunFrameLog& f) {
+    return static_cast<double>(std::max(f.keypoints, f.inliers));
+  });
+  const svg::Range dyn_r = MaxRange(run, [](const RunFrameLog& f) {
+    return static_cast<double>(std::max(f.rejected_keypoints, f.geometric_rejected));
+  });
+  const svg::Range inst_r =
+      MaxRange(run, [](const RunFrameLog& f) { return static_cast<double>(f.dynamic_instances); });
+  const svg::Range time_r = MaxRange(run, [](const RunFrameLog& f) {
     return std::max({f.segmentation_ms, f.extraction_ms, f.tracking_ms, f.mapping_ms});
   });
-  const Panel track{80, 60, 800, 200, frames, track_r};
-  const Panel dyn{80, 340, 800, 200, frames, dyn_r};
-  const Panel time{80, 620, 800, 180, frames, time_r};
+  const svg::Panel track{80, 60, 800, 200, frames, track_r};
+  const svg::Panel dyn{80, 340, 800, 200, frames, dyn_r};
+  const svg::Panel time{80, 620, 800, 180, frames, time_r};
 
   std::ostringstream os;
   os << "<svg xmlns='http://www.w3.org/2000/svg' width='" << kW << "' height='" << kH
      << "' viewBox='0 0 " << kW << " " << kH << "' font-family='Helvetica, Arial, sans-serif' "
      << "font-size='11'>\n<rect width='100%' height='100%' fill='#fafafa'/>\n";
 
-  Axes(os, track, "(a) Tracking: keypoints and landmark inliers (shaded: no pose)", "frame",
-       "count");
+  svg::Axes(os, track, "(a) Tracking: keypoints and landmark inliers (shaded: no pose)", "frame",
+            "count");
   ShadeLost(os, run, track);
   for (const RunFrameLog& f : run.per_frame) {  // keyframes: ticks on the bottom edge
     if (!f.keyframe) continue;
     const double x = track.X(static_cast<double>(f.index));
-    os << "<line x1='" << Num(x) << "' y1='" << Num(track.y + track.h) << "' x2='" << Num(x)
-       << "' y2='" << Num(track.y + track.h - 8) << "' stroke='" << kGreen << "'/>\n";
+    os << "<line x1='" << svg::Num(x) << "' y1='" << svg::Num(track.y + track.h) << "' x2='"
+       << svg::Num(x) << "' y2='" << svg::Num(track.y + track.h - 8) << "' stroke='" << kGreen
+       << "'/>\n";
   }
   for (const RunFrameLog& f : run.per_frame) {  // loop closures: full-height lines
     if (!f.loop_closed) continue;
     const double x = track.X(static_cast<double>(f.index));
-    os << "<line x1='" << Num(x) << "' y1='" << Num(track.y) << "' x2='" << Num(x) << "' y2='"
-       << Num(track.y + track.h) << "' stroke='" << kPurple << "' stroke-width='2'><title>loop closed at frame "
-       << f.index << "</title></line>\n";
+    os << "<line x1='" << svg::Num(x) << "' y1='" << svg::Num(track.y) << "' x2='" << svg::Num(x)
+       << "' y2='" << svg::Num(track.y + track.h) << "' stroke='" << kPurple
+       << "' stroke-width='2'><title>loop closed at frame " << f.index << "</title></line>\n";
   }
-  Polyline(os, Line(run, track, track_r, [](const RunFrameLog& f) { return static_cast<double>(f.keypoints); }), kGrey, 1.0);
-  Polyline(os, Line(run, track, track_r, [](const RunFrameLog& f) { return static_cast<double>(f.inliers); }), kBlue, 1.2);
-  Legend(os, track.x + track.w - 200, track.y + 10,
-         {{"keypoints", kGrey}, {"landmark inliers", kBlue}, {"keyframe (tick)", kGreen},
-          {"loop closed", kPurple}});
+  svg::Polyline(os,
+                Line(run, track, track_r,
+                     [](const RunFrameLog& f) { return static_cast<double>(f.keypoints); }),
+                kGrey, 1.0);
+  svg::Polyline(os,
+                Line(run, track, track_r,
+                     [](const RunFrameLog& f) { return static_cast<double>(f.inliers); }),
+                kBlue, 1.2);
+  svg::Legend(os, track.x + track.w - 200, track.y + 10,
+              {{"keypoints", kGrey},
+               {"landmark inliers", kBlue},
+               {"keyframe (tick)", kGreen},
+               {"loop closed", kPurple}});
 
-  Axes(os, dyn, "(b) Dynamic objects: rejected keypoints per frame", "frame", "keypoints");
+  svg::Axes(os, dyn, "(b) Dynamic objects: rejected keypoints per frame", "frame", "keypoints");
   RightAxis(os, dyn, inst_r, "dynamic objects", kGrey);
-  Polyline(os, Line(run, dyn, inst_r, [](const RunFrameLog& f) { return static_cast<double>(f.dynamic_instances); }), kGrey, 1.0);
-  Polyline(os, Line(run, dyn, dyn_r, [](const RunFrameLog& f) { return static_cast<double>(f.rejected_keypoints); }), kRed, 1.2);
-  Polyline(os, Line(run, dyn, dyn_r, [](const RunFrameLog& f) { return static_cast<double>(f.geometric_rejected); }), kOrange, 1.2);
-  Legend(os, dyn.x + dyn.w - 200, dyn.y + 10,
-         {{"dynamic filter", kRed}, {"geometric check", kOrange},
-          {"dynamic objects (right)", kGrey}});
+  svg::Polyline(os,
+                Line(run, dyn, inst_r,
+                     [](const RunFrameLog& f) { return static_cast<double>(f.dynamic_instances); }),
+                kGrey, 1.0);
+  svg::Polyline(
+      os,
+      Line(run, dyn, dyn_r,
+           [](const RunFrameLog& f) { return static_cast<double>(f.rejected_keypoints); }),
+      kRed, 1.2);
+  svg::Polyline(
+      os,
+      Line(run, dyn, dyn_r,
+           [](const RunFrameLog& f) { return static_cast<double>(f.geometric_rejected); }),
+      kOrange, 1.2);
+  svg::Legend(
+      os, dyn.x + dyn.w - 200, dyn.y + 10,
+      {{"dynamic filter", kRed}, {"geometric check", kOrange}, {"dynamic objects (right)", kGrey}});
 
-  Axes(os, time, "(c) Time per frame and stage", "frame", "ms");
-  Polyline(os, Line(run, time, time_r, [](const RunFrameLog& f) { return f.segmentation_ms; }), kPurple, 1.0);
-  Polyline(os, Line(run, time, time_r, [](const RunFrameLog& f) { return f.extraction_ms; }), kBlue, 1.0);
-  Polyline(os, Line(run, time, time_r, [](const RunFrameLog& f) { return f.tracking_ms; }), kGreen, 1.0);
-  Polyline(os, Line(run, time, time_r, [](const RunFrameLog& f) { return f.mapping_ms; }), kOrange, 1.0);
-  Legend(os, time.x + time.w - 200, time.y + 10,
-         {{"segmentation", kPurple}, {"extraction + filter", kBlue}, {"tracking", kGreen},
-          {"local mapping (keyframes)", kOrange}});
+  svg::Axes(os, time, "(c) Time per frame and stage", "frame", "ms");
+  svg::Polyline(os, Line(run, time, time_r, [](const RunFrameLog& f) { return f.segmentation_ms; }),
+                kPurple, 1.0);
+  svg::Polyline(os, Line(run, time, time_r, [](const RunFrameLog& f) { return f.extraction_ms; }),
+                kBlue, 1.0);
+  svg::Polyline(os, Line(run, time, time_r, [](const RunFrameLog& f) { return f.tracking_ms; }),
+                kGreen, 1.0);
+  svg::Polyline(os, Line(run, time, time_r, [](const RunFrameLog& f) { return f.mapping_ms; }),
+                kOrange, 1.0);
+  svg::Legend(os, time.x + time.w - 200, time.y + 10,
+              {{"segmentation", kPurple},
+               {"extraction + filter", kBlue},
+               {"tracking", kGreen},
+               {"local mapping (keyframes)", kOrange}});
   if (run.per_frame.empty()) {
-    os << "<text x='480' y='160' text-anchor='middle' fill='#888'>no frames in the run log</text>\n";
+    os << "<text x='480' y='160' text-anchor='middle' fill='#888'>no frames in the run "
+          "log</text>\n";
   }
   os << "</svg>\n";
   return os.str();
@@ -175,9 +198,10 @@ std::string RenderHtmlReport(const RunLog& run, const EvalResult* eval) {
   }
   std::ostringstream os;
   os << "<!DOCTYPE html>\n<html lang='en'>\n<head>\n<meta charset='utf-8'>\n<title>detslam report: "
-     << Escape(run.dataset) << "</title>\n<style>\n"
+     << svg::Escape(run.dataset) << "</title>\n<style>\n"
      << "body{font-family:Helvetica,Arial,sans-serif;margin:24px;max-width:1000px;color:#222}\n"
-     << "table{border-collapse:collapse;margin:8px 0 20px}th,td{border:1px solid #ccc;padding:3px 8px;"
+     << "table{border-collapse:collapse;margin:8px 0 20px}th,td{border:1px solid #ccc;padding:3px "
+        "8px;"
      << "text-align:left;vertical-align:top}th{background:#f0f0f0;font-weight:normal}\n"
      << "code{font-size:90%}.bad{color:#b00}\n</style>\n</head>\n<body>\n";
   os << "<h1>detslam run report</h1>\n<h2>Run</h2>\n<table>\n";
@@ -186,38 +210,47 @@ std::string RenderHtmlReport(const RunLog& run, const EvalResult* eval) {
      << TableRow("segmenter", run.segmenter);
   const size_t lost = LongestLost(run);
   os << "<tr><th>frames tracked</th><td" << (run.frames_tracked < run.frames ? " class='bad'" : "")
-     << ">" << run.frames_tracked << " / " << run.frames << " (" << Fixed(100.0 * run.TrackedFraction(), 1)
-     << " %); longest run without pose: " << lost << " frames</td></tr>\n";
-  os << TableRow("keyframes / map points", std::to_string(run.keyframes) + " / " + std::to_string(run.map_points))
+     << ">" << run.frames_tracked << " / " << run.frames << " ("
+     << Fixed(100.0 * run.TrackedFraction(), 1) << " %); longest run without pose: " << lost
+     << " frames</td></tr>\n";
+  os << TableRow("keyframes / map points",
+                 std::to_string(run.keyframes) + " / " + std::to_string(run.map_points))
      << TableRow("relocalisations / loops closed",
                  std::to_string(run.relocalizations) + " / " + std::to_string(run.loops_closed))
-     << TableRow("wall time", Fixed(run.wall_s, 1) + " s (" + Fixed(run.FramesPerSecond(), 1) + " frames/s)");
-  const ErrorStats s = ComputeErrorStats(seg), e = ComputeErrorStats(ext), t = ComputeErrorStats(trk);
+     << TableRow("wall time",
+                 Fixed(run.wall_s, 1) + " s (" + Fixed(run.FramesPerSecond(), 1) + " frames/s)");
+  const ErrorStats s = ComputeErrorStats(seg), e = ComputeErrorStats(ext),
+                   t = ComputeErrorStats(trk);
   os << TableRow("median ms per frame",
                  (s.count ? "segmentation " + Fixed(s.median, 1) + ", " : std::string()) +
-                     "extraction + filter " + Fixed(e.median, 1) + ", tracking " + Fixed(t.median, 1))
+                     "extraction + filter " + Fixed(e.median, 1) + ", tracking " +
+                     Fixed(t.median, 1))
      << "</table>\n";
   if (eval != nullptr) {
     const EvalResult& r = *eval;
     const bool per_s = r.rpe.per_second();
     const double div = per_s ? r.rpe.options.delta : 1.0;
-    os << "<h2>Accuracy</h2>\n<p>Against <code>" << Escape(r.gt_path) << "</code> with the TUM RGB-D "
-       << "tools' conventions (association within " << Label(r.options.max_difference_s)
+    os << "<h2>Accuracy</h2>\n<p>Against <code>" << svg::Escape(r.gt_path)
+       << "</code> with the TUM RGB-D "
+       << "tools' conventions (association within " << svg::Label(r.options.max_difference_s)
        << " s, " << (r.options.with_scale ? "Sim(3)" : "SE(3)") << " alignment).</p>\n<table>\n"
        << "<tr><th></th><th>RMSE</th><th>mean</th><th>median</th><th>max</th></tr>\n"
        << "<tr><th>ATE (mm)</th><td>" << Fixed(1000 * r.ate.error_m.rmse, 1) << "</td><td>"
-       << Fixed(1000 * r.ate.error_m.mean, 1) << "</td><td>" << Fixed(1000 * r.ate.error_m.median, 1)
-       << "</td><td>" << Fixed(1000 * r.ate.error_m.max, 1) << "</td></tr>\n"
+       << Fixed(1000 * r.ate.error_m.mean, 1) << "</td><td>"
+       << Fixed(1000 * r.ate.error_m.median, 1) << "</td><td>" << Fixed(1000 * r.ate.error_m.max, 1)
+       << "</td></tr>\n"
        << "<tr><th>RPE translation (" << (per_s ? "mm/s" : "mm") << ")</th><td>"
-       << Fixed(1000 * r.rpe.trans_m.rmse / div, 1) << "</td><td>" << Fixed(1000 * r.rpe.trans_m.mean / div, 1)
-       << "</td><td>" << Fixed(1000 * r.rpe.trans_m.median / div, 1) << "</td><td>"
+       << Fixed(1000 * r.rpe.trans_m.rmse / div, 1) << "</td><td>"
+       << Fixed(1000 * r.rpe.trans_m.mean / div, 1) << "</td><td>"
+       << Fixed(1000 * r.rpe.trans_m.median / div, 1) << "</td><td>"
        << Fixed(1000 * r.rpe.trans_m.max / div, 1) << "</td></tr>\n"
        << "<tr><th>RPE rotation (" << (per_s ? "deg/s" : "deg") << ")</th><td>"
        << Fixed(r.rpe.rot_deg.rmse / div, 3) << "</td><td>" << Fixed(r.rpe.rot_deg.mean / div, 3)
        << "</td><td>" << Fixed(r.rpe.rot_deg.median / div, 3) << "</td><td>"
        << Fixed(r.rpe.rot_deg.max / div, 3) << "</td></tr>\n</table>\n"
        << "<p>Frames with ground truth that have a pose: " << r.coverage.frames_tracked << " / "
-       << r.coverage.frames_with_gt << " (" << Fixed(100.0 * r.coverage.fraction, 1) << " %).</p>\n";
+       << r.coverage.frames_with_gt << " (" << Fixed(100.0 * r.coverage.fraction, 1)
+       << " %).</p>\n";
     std::string figure = RenderEvalSvg(r);
     if (figure.rfind("<?xml", 0) == 0) figure = figure.substr(figure.find('\n') + 1);
     os << figure;
@@ -225,8 +258,8 @@ std::string RenderHtmlReport(const RunLog& run, const EvalResult* eval) {
     os << "<h2>Accuracy</h2>\n<p>No ground truth given (<code>detslam report --gt FILE</code>), "
           "so no accuracy section.</p>\n";
   }
-  os << "<h2>Per frame</h2>\n" << RenderRunSvg(run)
-     << "<p>Made by <code>detslam report</code>.</p>\n</body>\n</html>\n";
+  os << "<h2>Per frame</h2>\n"
+     << RenderRunSvg(run) << "<p>Made by <code>detslam report</code>.</p>\n</body>\n</html>\n";
   return os.str();
 }
 

@@ -67,8 +67,8 @@ TEST(RunReport, PerFrameFigureHasItsPanelsLinesAndMarks) {
                         "landmark inliers", "geometric check", "segmentation"}) {
     EXPECT_THAT(svg, HasSubstr(s));
   }
-  EXPECT_EQ(Count(svg, "<polyline"), 9u);  // 2 tracking, 3 dynamic, 4 timing lines
-  EXPECT_EQ(Count(svg, "fill='#ff9896'"), 1u);  // one run of frames without pose
+  EXPECT_EQ(Count(svg, "<polyline"), 9u);           // 2 tracking, 3 dynamic, 4 timing lines
+  EXPECT_EQ(Count(svg, "fill='#ff9896'"), 1u);      // one run of frames without pose
   EXPECT_EQ(Count(svg, "stroke='#2ca02c'/>"), 2u);  // two keyframe ticks
   EXPECT_THAT(svg, HasSubstr("loop closed at frame 15"));
   EXPECT_EQ(Count(svg, "<text"), Count(svg, "</text>"));
@@ -112,7 +112,8 @@ TEST(RunReport, HtmlWithEvaluationEmbedsTheAccuracyFigure) {
 }
 
 TEST(RunReport, WritesAtomically) {
-  const fs::path dir = fs::path(::testing::TempDir()) / ("detslam_report_" + std::to_string(::getpid()));
+  const fs::path dir =
+      fs::path(::testing::TempDir()) / ("detslam_report_" + std::to_string(::getpid()));
   fs::create_directories(dir);
   const std::string path = (dir / "report.html").string();
   WriteHtmlReport(path, HandLog(), nullptr);

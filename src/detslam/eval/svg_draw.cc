@@ -21,12 +21,18 @@ std::string Label(double v) {
 std::string Escape(const std::string& s) {
   std::string out;
   for (char c : s) {
-    if (c == '<') out += "&lt;";
-    else if (c == '>') out += "&gt;";
-    else if (c == '&') out += "&amp;";
-    else if (c == '\'') out += "&#39;";
-    else if (c == '"') out += "&quot;";
-    else out += c;
+    if (c == '<')
+      out += "&lt;";
+    else if (c == '>')
+      out += "&gt;";
+    else if (c == '&')
+      out += "&amp;";
+    else if (c == '\'')
+      out += "&#39;";
+    else if (c == '"')
+      out += "&quot;";
+    else
+      out += c;
   }
   return out;
 }
@@ -59,20 +65,20 @@ Range Range::Of(const std::vector<double>& v, bool from_zero) {
 
 void Axes(std::ostringstream& os, const Panel& p, const std::string& title,
           const std::string& xlabel, const std::string& ylabel) {
-  os << "<rect x='" << Num(p.x) << "' y='" << Num(p.y) << "' width='" << Num(p.w)
-     << "' height='" << Num(p.h) << "' fill='white' stroke='#888'/>\n";
+  os << "<rect x='" << Num(p.x) << "' y='" << Num(p.y) << "' width='" << Num(p.w) << "' height='"
+     << Num(p.h) << "' fill='white' stroke='#888'/>\n";
   const double xs = NiceStep(p.xr.hi - p.xr.lo, 8), ys = NiceStep(p.yr.hi - p.yr.lo, 5);
   for (double v = std::ceil(p.xr.lo / xs) * xs; v <= p.xr.hi + 1e-9 * xs; v += xs) {
-    os << "<line x1='" << Num(p.X(v)) << "' y1='" << Num(p.y) << "' x2='" << Num(p.X(v))
-       << "' y2='" << Num(p.y + p.h) << "' stroke='#eee'/>"
-       << "<text x='" << Num(p.X(v)) << "' y='" << Num(p.y + p.h + 14)
-       << "' text-anchor='middle'>" << Label(v) << "</text>\n";
+    os << "<line x1='" << Num(p.X(v)) << "' y1='" << Num(p.y) << "' x2='" << Num(p.X(v)) << "' y2='"
+       << Num(p.y + p.h) << "' stroke='#eee'/>"
+       << "<text x='" << Num(p.X(v)) << "' y='" << Num(p.y + p.h + 14) << "' text-anchor='middle'>"
+       << Label(v) << "</text>\n";
   }
   for (double v = std::ceil(p.yr.lo / ys) * ys; v <= p.yr.hi + 1e-9 * ys; v += ys) {
     os << "<line x1='" << Num(p.x) << "' y1='" << Num(p.Y(v)) << "' x2='" << Num(p.x + p.w)
        << "' y2='" << Num(p.Y(v)) << "' stroke='#eee'/>"
-       << "<text x='" << Num(p.x - 6) << "' y='" << Num(p.Y(v) + 4)
-       << "' text-anchor='end'>" << Label(v) << "</text>\n";
+       << "<text x='" << Num(p.x - 6) << "' y='" << Num(p.Y(v) + 4) << "' text-anchor='end'>"
+       << Label(v) << "</text>\n";
   }
   os << "<text x='" << Num(p.x) << "' y='" << Num(p.y - 10)
      << "' font-size='14' font-weight='bold'>" << Escape(title) << "</text>\n";

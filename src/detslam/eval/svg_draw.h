@@ -9,9 +9,9 @@
 
 namespace detslam::svg {
 
-std::string Num(double v);                  // coordinate, 2 decimals
-std::string Label(double v);                // tick label (%g, no "-0")
-std::string Escape(const std::string& s);   // text for XML/HTML (&, <, >, ', ")
+std::string Num(double v);                 // coordinate, 2 decimals
+std::string Label(double v);               // tick label (%g, no "-0")
+std::string Escape(const std::string& s);  // text for XML/HTML (&, <, >, ', ")
 // Tick step of 1, 2 or 5 times a power of ten giving about `target` ticks over `span`.
 double NiceStep(double span, int target);
 
