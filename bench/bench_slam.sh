@@ -7,6 +7,7 @@
 #    fraction, loops closed, ATE and end drift;
 #  - the depth weighting (RGBD.DisparitySigma, DISPARITY_SIGMAS) on fr2/desk and the static seeds:
 #    the table the default was chosen from (0 = ORB-SLAM3's u_right residual);
+#  - triangulation between keyframes on and off, on the same sequences;
 # and writes the tables into docs/BENCHMARKS.md (section slam) via bench/update_section.py.
 # Usage: bench/bench_slam.sh [path/to/detslam]
 #   (env: STATIC_FRAMES=600, SEEDS="1 2 3", DISPARITY_SIGMAS="0 0.05 0.1 0.2")
@@ -112,8 +113,26 @@ sweep_row() {  # name dataset_dir
   echo "| $name |$cells" >>"$out"
 }
 [[ -d "$fr2" ]] && sweep_row "fr2/desk (50 frames)" "$fr2"
+for s in $seeds; do sweep_row "static, seed $s" "$work/static_$s"; done
+
+# Triangulation of new landmarks between keyframes, on (default) and off.
+{
+  echo
+  echo "### Triangulation between keyframes (\`LocalMapping.Triangulate\`)"
+  echo
+  echo "Keypoints without close depth are matched with the best covisible keyframes and"
+  echo "triangulated (ORB-SLAM3's CreateNewMapPoints). ATE RMSE mm (tracked frames)."
+  echo
+  echo "| sequence | on (default) | off |"
+  echo "|---|---:|---:|"
+} >>"$out"
+tri_row() {  # name dataset_dir default_run_dir (the default run from the tables above)
+  run_eval "$2" "$work/tri_off" 42 --set LocalMapping.Triangulate=0
+  echo "| $1 | $(ate_cell "$3") | $(ate_cell "$work/tri_off") |" >>"$out"
+}
+[[ -d "$fr2" ]] && tri_row "fr2/desk (50 frames)" "$fr2" "$work/fr2_a"
 for s in $seeds; do
-  sweep_row "static, seed $s" "$work/static_$s"
+  tri_row "static, seed $s" "$work/static_$s" "$work/static_${s}_run"
   rm -rf "$work/static_$s"
 done
 

@@ -21,6 +21,9 @@ struct KeyFrame {
   Rigid3d cam_from_world;
   std::shared_ptr<const FrameFeatures> features;
   std::vector<LandmarkId> landmarks;        // per keypoint
+  // Per keypoint (may be empty: all static): kGeometric where the tracker's geometric check found
+  // a mover in the frame this keyframe was made from; such keypoints never get new landmarks.
+  std::vector<KeypointLabel> labels;
   std::map<KeyFrameId, int> covisibility;   // neighbour -> shared landmarks (>= 1)
   KeyFrameId parent = kNoKeyFrame;          // spanning tree
   std::set<KeyFrameId> children;

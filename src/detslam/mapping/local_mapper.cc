@@ -19,6 +19,7 @@ bool LocalMapperOptions::Check(std::string* error) const {
   std::ostringstream os;
   if (ba_iterations < 1) os << "ba_iterations must be >= 1; ";
   if (max_local_keyframes < 1) os << "max_local_keyframes must be >= 1; ";
+  if (triangulation_neighbours < 1) os << "triangulation_neighbours must be >= 1; ";
   if (!(redundancy > 0 && redundancy <= 1)) os << "redundancy must be in (0, 1]; ";
   if (error) *error = os.str();
   return os.str().empty();
@@ -47,6 +48,7 @@ LocalMappingSummary LocalMapper::ProcessKeyFrame(KeyFrameId current, std::mutex*
   }
   map_->UpdateConnections(current);
   CullLandmarks(current, &summary);
+  if (options_.triangulate) TriangulateNewLandmarks(current, &summary);
   if (options_.fuse) FuseWithNeighbours(current, &summary);
   if (options_.local_ba && map_->NumKeyFrames() > 2) LocalBundleAdjustment(current, &summary, &lock);
   if (options_.cull_keyframes) CullKeyFrames(current, &summary);

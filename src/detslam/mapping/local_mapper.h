@@ -1,6 +1,7 @@
-// Local mapping for RGB-D keyframes (ORB-SLAM3 rules): landmark culling, fusion of duplicate
-// landmarks with neighbour keyframes, local bundle adjustment (Ceres) over the keyframe's
-// covisibility neighbourhood, and redundant-keyframe culling.
+// Local mapping for RGB-D keyframes (ORB-SLAM3 rules): landmark culling, triangulation of new
+// landmarks with neighbour keyframes, fusion of duplicate landmarks with neighbour keyframes,
+// local bundle adjustment (Ceres) over the keyframe's covisibility neighbourhood, and
+// redundant-keyframe culling.
 #pragma once
 
 #include <deque>
@@ -23,6 +24,10 @@ struct LocalMapperOptions {
   bool cull_keyframes = true;        // KeyFrameCulling
   double redundancy = 0.9;           // cull if this fraction of points is seen by >= 3 others
   double min_found_ratio = 0.25;     // landmark culling: found / visible
+  // CreateNewMapPoints: keypoints without a landmark and without close depth (none, or beyond
+  // ThDepth) are matched with those of the best covisible keyframes and triangulated.
+  bool triangulate = true;
+  int triangulation_neighbours = 10;  // best covisible keyframes to triangulate with (RGB-D: 10)
   bool Check(std::string* error) const;
 };
 
@@ -36,6 +41,7 @@ struct ErasedKeyFrame {
 
 struct LocalMappingSummary {
   int fused = 0;
+  int triangulated = 0;
   int culled_landmarks = 0;
   int ba_outliers = 0;
   double ba_ms = 0.0;
@@ -53,6 +59,7 @@ class LocalMapper {
 
  private:
   void CullLandmarks(KeyFrameId current, LocalMappingSummary* summary);
+  void TriangulateNewLandmarks(KeyFrameId current, LocalMappingSummary* summary);  // triangulate.cc
   void FuseWithNeighbours(KeyFrameId current, LocalMappingSummary* summary);
   void LocalBundleAdjustment(KeyFrameId current, LocalMappingSummary* summary,
                              std::unique_lock<std::mutex>* lock);

@@ -94,6 +94,7 @@ SlamOptions SlamOptionsFromSettings(const Settings& settings, uint64_t seed) {
   o.tracker.keyframe_far_points = settings.GetInt("Tracking.KeyFrameFarPoints", o.tracker.keyframe_far_points);
   o.mapper.local_ba = settings.GetBool("LocalMapping.BundleAdjustment", o.mapper.local_ba);
   o.mapper.max_local_keyframes = settings.GetInt("LocalMapping.MaxLocalKeyFrames", o.mapper.max_local_keyframes);
+  o.mapper.triangulate = settings.GetBool("LocalMapping.Triangulate", o.mapper.triangulate);
   o.loop.enabled = settings.GetBool("LoopClosing.Enabled", o.loop.enabled);
   o.loop.candidate_radius_m = settings.GetDouble("LoopClosing.CandidateRadius", o.loop.candidate_radius_m);
   o.loop.global_ba_iterations = settings.GetInt("LoopClosing.GlobalBAIterations", o.loop.global_ba_iterations);

@@ -190,6 +190,7 @@ KeyFrameId Tracker::CreateKeyFrame(Frame* frame) {
   kf.stamp = frame->stamp;
   kf.cam_from_world = *frame->cam_from_world;
   kf.features = frame->features;
+  kf.labels = frame->labels;
   const KeyFrameId id = map_->AddKeyFrame(std::move(kf));
   for (size_t i = 0; i < frame->size(); ++i) {
     const LandmarkId lm = frame->landmarks[i];

@@ -1,0 +1,114 @@
+// LocalMapper::TriangulateNewLandmarks: ORB-SLAM3's CreateNewMapPoints for RGB-D keyframes.
+// Keypoints of the new keyframe that have no landmark and no close depth (none, or beyond
+// ThDepth; close ones already became landmarks from depth) are matched by descriptor with the same
+// kind of keypoints of its best covisible keyframes (brute force, ratio 0.6, orientation
+// consistency), triangulated (DLT) where the rays have parallax (cos < 0.9998) and the baseline
+// exceeds the sensor's, and kept when the point lies in front of both cameras, reprojects within
+// the 95% chi2 gate of its keypoint's octave in both (with depth: the RGB-D residual) and its
+// distances to the two cameras agree with the two octaves (scale consistency).
+#include <cmath>
+#include <vector>
+
+#include "detslam/features/matcher.h"
+#include "detslam/geometry/projection.h"
+#include "detslam/geometry/triangulation.h"
+#include "detslam/mapping/local_mapper.h"
+
+namespace detslam {
+namespace {
+
+constexpr double kMinCosParallax = 0.9998;
+constexpr double kChi2Mono = 5.991;
+constexpr double kChi2Stereo = 7.815;
+
+// Keypoints of `kf` that may get a triangulated landmark.
+std::vector<int> Candidates(const KeyFrame& kf, double close_depth) {
+  std::vector<int> out;
+  const FrameFeatures& f = *kf.features;
+  for (size_t i = 0; i < kf.size(); ++i) {
+    if (kf.landmarks[i] != kNoLandmark) continue;
+    if (!kf.labels.empty() && kf.labels[i] != KeypointLabel::kStatic) continue;
+    if (f.depth[i] > 0 && f.depth[i] <= close_depth) continue;
+    out.push_back(static_cast<int>(i));
+  }
+  return out;
+}
+
+// The observation's chi2 at `p_world` (with depth: the RGB-D residual).
+bool WithinGate(const PinholeCamera& camera, const ScaleInfo& scale, const KeyFrame& kf, size_t i,
+                const Eigen::Vector3d& p_world) {
+  const FrameFeatures& f = *kf.features;
+  const Eigen::Vector3d p_cam = kf.cam_from_world * p_world;
+  if (p_cam.z() <= 0) return false;
+  const double sqrt_info =
+      std::sqrt(scale.inv_level_sigma2[static_cast<size_t>(f.keypoints[i].octave)]);
+  const Eigen::Vector3d r =
+      WhitenedStereoResidual(camera, p_cam, f.undist[i], f.u_right[i], sqrt_info);
+  return f.u_right[i] >= 0 ? r.squaredNorm() <= kChi2Stereo
+                           : r.head<2>().squaredNorm() <= kChi2Mono;
+}
+
+}  // namespace
+
+void LocalMapper::TriangulateNewLandmarks(KeyFrameId current, LocalMappingSummary* summary) {
+  const ScaleInfo& scale = map_->scale();
+  const double close_depth = camera_.CloseDepthThreshold();
+  const double ratio_factor = 1.5 * (scale.scale_factors.size() > 1 ? scale.scale_factors[1] : 1.2);
+  MatchOptions match;
+  match.ratio = 0.6;
+  match.max_distance = kThLow;
+  for (KeyFrameId other :
+       map_->BestCovisibles(current, static_cast<size_t>(options_.triangulation_neighbours))) {
+    const KeyFrame& kf1 = map_->keyframe(current);
+    const KeyFrame& kf2 = map_->keyframe(other);
+    if ((kf1.Center() - kf2.Center()).norm() < camera_.Baseline()) continue;  // too close
+    const std::vector<int> c1 = Candidates(kf1, close_depth), c2 = Candidates(kf2, close_depth);
+    if (c1.empty() || c2.empty()) continue;
+    const FrameFeatures& f1 = *kf1.features;
+    const FrameFeatures& f2 = *kf2.features;
+    std::vector<cv::KeyPoint> kp1, kp2;
+    cv::Mat d1(static_cast<int>(c1.size()), 32, CV_8UC1),
+        d2(static_cast<int>(c2.size()), 32, CV_8UC1);
+    for (size_t k = 0; k < c1.size(); ++k) {
+      kp1.push_back(f1.keypoints[static_cast<size_t>(c1[k])]);
+      f1.descriptors.row(c1[k]).copyTo(d1.row(static_cast<int>(k)));
+    }
+    for (size_t k = 0; k < c2.size(); ++k) {
+      kp2.push_back(f2.keypoints[static_cast<size_t>(c2[k])]);
+      f2.descriptors.row(c2[k]).copyTo(d2.row(static_cast<int>(k)));
+    }
+    for (const cv::DMatch& m : MatchBruteForce(kp1, d1, kp2, d2, match)) {
+      const size_t i1 = static_cast<size_t>(c1[static_cast<size_t>(m.queryIdx)]);
+      const size_t i2 = static_cast<size_t>(c2[static_cast<size_t>(m.trainIdx)]);
+      if (map_->keyframe(current).landmarks[i1] != kNoLandmark)
+        continue;  // taken by an earlier pair
+      if (map_->keyframe(other).landmarks[i2] != kNoLandmark) continue;
+      const Eigen::Vector2d xn1 = PixelToNormalized(camera_, f1.undist[i1]);
+      const Eigen::Vector2d xn2 = PixelToNormalized(camera_, f2.undist[i2]);
+      const double cos_parallax = CosParallaxRays(kf1.cam_from_world, kf2.cam_from_world, xn1, xn2);
+      if (!(cos_parallax > 0 && cos_parallax < kMinCosParallax)) continue;
+      Eigen::Vector3d p;
+      if (!TriangulateLinear(kf1.cam_from_world, kf2.cam_from_world, xn1, xn2, &p)) continue;
+      if (!WithinGate(camera_, scale, kf1, i1, p) || !WithinGate(camera_, scale, kf2, i2, p))
+        continue;
+      // Scale consistency: distance ratio against octave ratio.
+      const double dist1 = (p - kf1.Center()).norm(), dist2 = (p - kf2.Center()).norm();
+      if (dist1 <= 0 || dist2 <= 0) continue;
+      const double ratio_dist = dist2 / dist1;
+      const double ratio_octave =
+          scale.scale_factors[static_cast<size_t>(f1.keypoints[i1].octave)] /
+          scale.scale_factors[static_cast<size_t>(f2.keypoints[i2].octave)];
+      if (ratio_dist * ratio_factor < ratio_octave || ratio_dist > ratio_octave * ratio_factor)
+        continue;
+      const LandmarkId lm = map_->AddLandmark(p, current);
+      map_->AddObservation(lm, current, i1);
+      map_->AddObservation(lm, other, i2);
+      map_->UpdateLandmarkDescriptor(lm);
+      map_->UpdateLandmarkGeometry(lm);
+      recent_landmarks_.push_back(lm);
+      ++summary->triangulated;
+    }
+  }
+}
+
+}  // namespace detslam
