@@ -5,6 +5,18 @@
 
 namespace detslam {
 
+ScaleInfo ScaleInfo::Geometric(double scale_factor, int num_levels) {
+  ScaleInfo s;
+  for (int l = 0; l < num_levels; ++l) {
+    const double f = std::pow(scale_factor, l);
+    s.scale_factors.push_back(f);
+    s.level_sigma2.push_back(f * f);
+    s.inv_level_sigma2.push_back(1.0 / (f * f));
+  }
+  s.log_scale_factor = std::log(scale_factor);
+  return s;
+}
+
 ImageBounds UndistortedBounds(const PinholeCamera& camera) {
   ImageBounds b{0.0, static_cast<double>(camera.width), 0.0, static_cast<double>(camera.height)};
   if (!camera.HasDistortion()) return b;

@@ -32,6 +32,8 @@ struct ScaleInfo {
   std::vector<double> inv_level_sigma2;  // 1 / scale^2
   double log_scale_factor = 0.0;         // log(s)
   int num_levels() const { return static_cast<int>(scale_factors.size()); }
+  // The pyramid of `num_levels` levels with factor `scale_factor` (sigma of a level = its scale).
+  static ScaleInfo Geometric(double scale_factor, int num_levels);
 };
 
 struct FrameFeatures {

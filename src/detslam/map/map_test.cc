@@ -5,17 +5,7 @@
 namespace detslam {
 namespace {
 
-ScaleInfo TestScale() {
-  ScaleInfo s;
-  for (int l = 0; l < 8; ++l) {
-    const double f = std::pow(1.2, l);
-    s.scale_factors.push_back(f);
-    s.level_sigma2.push_back(f * f);
-    s.inv_level_sigma2.push_back(1.0 / (f * f));
-  }
-  s.log_scale_factor = std::log(1.2);
-  return s;
-}
+ScaleInfo TestScale() { return ScaleInfo::Geometric(1.2, 8); }
 
 std::shared_ptr<FrameFeatures> Features(size_t n, uint8_t fill) {
   auto f = std::make_shared<FrameFeatures>();
@@ -35,6 +25,16 @@ KeyFrame MakeKeyFrame(size_t n, double x) {
   kf.features = Features(n, static_cast<uint8_t>(x * 10));
   kf.cam_from_world = Rigid3d(Eigen::Quaterniond::Identity(), Eigen::Vector3d(-x, 0, 0));
   return kf;
+}
+
+TEST(ScaleInfo, GeometricPyramid) {
+  const ScaleInfo s = ScaleInfo::Geometric(1.2, 8);
+  ASSERT_EQ(s.num_levels(), 8);
+  EXPECT_DOUBLE_EQ(s.scale_factors[0], 1.0);
+  EXPECT_DOUBLE_EQ(s.scale_factors[2], 1.44);
+  EXPECT_DOUBLE_EQ(s.level_sigma2[2], 1.44 * 1.44);
+  EXPECT_DOUBLE_EQ(s.inv_level_sigma2[2], 1.0 / (1.44 * 1.44));
+  EXPECT_DOUBLE_EQ(s.log_scale_factor, std::log(1.2));
 }
 
 TEST(Map, ObservationsAreMirroredAndCovisibilityCountsSharedPoints) {

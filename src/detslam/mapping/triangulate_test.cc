@@ -11,17 +11,7 @@
 namespace detslam {
 namespace {
 
-ScaleInfo TestScale() {
-  ScaleInfo s;
-  for (int l = 0; l < 8; ++l) {
-    const double f = std::pow(1.2, l);
-    s.scale_factors.push_back(f);
-    s.level_sigma2.push_back(f * f);
-    s.inv_level_sigma2.push_back(1.0 / (f * f));
-  }
-  s.log_scale_factor = std::log(1.2);
-  return s;
-}
+ScaleInfo TestScale() { return ScaleInfo::Geometric(1.2, 8); }
 
 struct Scene {
   std::vector<Eigen::Vector3d> far_points;  // true positions of the keypoints 20..69
