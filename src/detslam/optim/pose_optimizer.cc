@@ -80,14 +80,13 @@ class PoseProblem {
       const Eigen::Matrix<double, 3, 6> jp = StereoPoseJacobian(camera_, p_cam);
       Eigen::Matrix<double, 3, 6> j = obs_[i].sqrt_info * jp;
       if (camera_.disparity_sigma > 0) j.row(2) = (jp.row(0) - jp.row(2)) / camera_.disparity_sigma;
-      const double w = weight;
       if (obs_[i].stereo) {
-        h->noalias() += w * j.transpose() * j;
-        g->noalias() += w * j.transpose() * r;
+        h->noalias() += weight * j.transpose() * j;
+        g->noalias() += weight * j.transpose() * r;
       } else {
         const Eigen::Matrix<double, 2, 6> jm = j.topRows<2>();
-        h->noalias() += w * jm.transpose() * jm;
-        g->noalias() += w * jm.transpose() * r.head<2>();
+        h->noalias() += weight * jm.transpose() * jm;
+        g->noalias() += weight * jm.transpose() * r.head<2>();
       }
     }
     return total;
