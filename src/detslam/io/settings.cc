@@ -398,10 +398,8 @@ void ApplySettingOverrides(const std::vector<std::string>& overrides, Settings* 
     }
     const std::string key = o.substr(0, eq);
     if (key == "RGBD.DisparitySigma") {  // a weighting of the depth, not a calibration
-      char* end = nullptr;
-      const std::string value = o.substr(eq + 1);
-      const double sigma = std::strtod(value.c_str(), &end);
-      if (end == value.c_str() || *end != '\0' || !(sigma >= 0)) {
+      double sigma = -1;
+      if (!ParseDoubleText(o.substr(eq + 1), &sigma) || !(sigma >= 0)) {
         throw InputError("--set " + o + ": RGBD.DisparitySigma must be a number >= 0");
       }
       settings->camera.disparity_sigma = sigma;

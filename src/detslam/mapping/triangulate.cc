@@ -34,6 +34,16 @@ std::vector<int> Candidates(const KeyFrame& kf, double close_depth) {
   return out;
 }
 
+// Keypoints and descriptors of `f` at `indices`, in that order (the matcher's inputs).
+void Subset(const FrameFeatures& f, const std::vector<int>& indices, std::vector<cv::KeyPoint>* kps,
+            cv::Mat* descriptors) {
+  *descriptors = cv::Mat(static_cast<int>(indices.size()), 32, CV_8UC1);
+  for (size_t k = 0; k < indices.size(); ++k) {
+    kps->push_back(f.keypoints[static_cast<size_t>(indices[k])]);
+    f.descriptors.row(indices[k]).copyTo(descriptors->row(static_cast<int>(k)));
+  }
+}
+
 // The observation's chi2 at `p_world` (with depth: the RGB-D residual).
 bool WithinGate(const PinholeCamera& camera, const ScaleInfo& scale, const KeyFrame& kf, size_t i,
                 const Eigen::Vector3d& p_world) {
@@ -67,16 +77,9 @@ void LocalMapper::TriangulateNewLandmarks(KeyFrameId current, LocalMappingSummar
     const FrameFeatures& f1 = *kf1.features;
     const FrameFeatures& f2 = *kf2.features;
     std::vector<cv::KeyPoint> kp1, kp2;
-    cv::Mat d1(static_cast<int>(c1.size()), 32, CV_8UC1),
-        d2(static_cast<int>(c2.size()), 32, CV_8UC1);
-    for (size_t k = 0; k < c1.size(); ++k) {
-      kp1.push_back(f1.keypoints[static_cast<size_t>(c1[k])]);
-      f1.descriptors.row(c1[k]).copyTo(d1.row(static_cast<int>(k)));
-    }
-    for (size_t k = 0; k < c2.size(); ++k) {
-      kp2.push_back(f2.keypoints[static_cast<size_t>(c2[k])]);
-      f2.descriptors.row(c2[k]).copyTo(d2.row(static_cast<int>(k)));
-    }
+    cv::Mat d1, d2;
+    Subset(f1, c1, &kp1, &d1);
+    Subset(f2, c2, &kp2, &d2);
     for (const cv::DMatch& m : MatchBruteForce(kp1, d1, kp2, d2, match)) {
       const size_t i1 = static_cast<size_t>(c1[static_cast<size_t>(m.queryIdx)]);
       const size_t i2 = static_cast<size_t>(c2[static_cast<size_t>(m.trainIdx)]);
