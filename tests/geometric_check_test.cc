@@ -29,10 +29,10 @@ CheckCounts RunGeometricCheck(bool people, int frames) {
   so.people = people;
   const SyntheticSequence seq(so);
   SlamOptions options;
-  options.tracker.geometric_check = true;
+  options.dynamic.geometric.enabled = true;
   const SlamSystem extractor(seq.camera(), options);  // used for feature extraction only
   Map map(MakeScaleInfo(OrbExtractor(options.orb)));
-  Tracker tracker(seq.camera(), options.tracker, &map);
+  Tracker tracker(seq.camera(), options.tracker, options.dynamic.geometric);
   CheckCounts c;
   const cv::Mat kernel = cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(11, 11));
   for (int k = 0; k < seq.size(); ++k) {
@@ -43,10 +43,10 @@ CheckCounts RunGeometricCheck(bool people, int frames) {
     cv::dilate(f.instance_mask > 0, on_person, kernel);
     FrameReport report;
     Frame frame = extractor.ExtractFrame(k, f.stamp, gray, depth, cv::Mat(), &report);
-    const TrackingResult r = tracker.Track(&frame);
+    const TrackingResult r = tracker.Track(map, &frame);
     if (!r.pose_valid) continue;
     ++c.tracked;
-    if (r.need_keyframe) tracker.CreateKeyFrame(&frame);
+    if (r.need_keyframe) tracker.CreateKeyFrame(map, &frame);
     c.keypoints += static_cast<int>(frame.size());
     int labelled = 0;
     for (size_t i = 0; i < frame.size(); ++i) {

@@ -35,7 +35,6 @@ LoopRun RunLoopPreset(const SyntheticSequence& seq, bool loop_closing) {
     ++run.frames;
     gt.push_back({f.stamp, f.world_from_cam});
   }
-  slam.Finish();
   run.loops = slam.loops_closed();
   run.ate_m = ComputeAte(gt, slam.FrameTrajectory(), AteOptions()).error_m.rmse;
   return run;

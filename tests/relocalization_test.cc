@@ -40,7 +40,6 @@ TEST(IntegrationRelocalization, RecoversAfterBlankFrames) {
     }
     gt.push_back({f.stamp, f.world_from_cam});
   }
-  slam.Finish();
   EXPECT_TRUE(lost_seen);
   EXPECT_TRUE(relocalized);
   EXPECT_GE(tracked_after_gap, 65);  // of 70 frames after the gap

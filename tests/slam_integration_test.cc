@@ -41,7 +41,7 @@ SlamRun RunAndEvaluate(const std::string& dataset_dir, const std::string& out_di
   options.out_dir = out_dir;
   options.threaded = threaded;
   options.slam = SlamOptionsFromSettings(settings, seed);
-  options.slam.mapping_thread = mapping_thread;
+  options.mapping_thread = mapping_thread;
   const std::unique_ptr<Segmenter> segmenter = MakeSegmenter(segmenter_spec, dataset_dir, settings, "");
   SlamRun run;
   run.summary = Run(dataset, settings, options, nullptr, segmenter.get());

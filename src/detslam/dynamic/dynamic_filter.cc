@@ -17,13 +17,7 @@ constexpr int64_t kMaxHistogramBins = 10'000'000;
 
 bool ValidDepth(float d) { return d > 0.0f && std::isfinite(d) && d < kMaxDepthM; }
 
-// One dynamic instance, rasterised once and shared by the keypoint and pixel versions.
-struct InstanceRegion {
-  cv::Rect roi;            // where `dilated` lies in the image
-  cv::Mat dilated;         // CV_8UC1, roi-sized, non-zero = inside the dilated mask
-  cv::Rect box;            // the instance box clipped to the image
-  DepthInterval interval;  // invalid when the depth step is off or has no depth
-};
+using InstanceRegion = DynamicRegions::Region;
 
 void CheckOptions(const DynamicFilterOptions& options) {
   std::string error;
@@ -95,19 +89,6 @@ InstanceRegion BuildRegion(const Instance& instance, const cv::Mat& depth_m,
     region.interval = ObjectDepthInterval(depth_m, instance.mask, instance.box, options);
   }
   return region;
-}
-
-std::vector<InstanceRegion> BuildRegions(const std::vector<Instance>& instances,
-                                         const cv::Mat& depth_m, const cv::Size& image_size,
-                                         const DynamicFilterOptions& options, int* used) {
-  std::vector<InstanceRegion> regions;
-  *used = 0;
-  for (const Instance& instance : instances) {
-    if (!UsesInstance(instance, options)) continue;
-    ++*used;
-    regions.push_back(BuildRegion(instance, depth_m, image_size, options));
-  }
-  return regions;
 }
 
 bool InsideDilated(const InstanceRegion& region, const cv::Point& p) {
@@ -227,24 +208,35 @@ DepthInterval ObjectDepthInterval(const cv::Mat& depth_m, const cv::Mat& mask, c
   return out;
 }
 
-DynamicFilterStats LabelDynamicKeypoints(const std::vector<cv::KeyPoint>& keypoints,
+DynamicRegions DynamicRegions::Build(const std::vector<Instance>& instances,
+                                     const cv::Mat& depth_m, const cv::Size& image_size,
+                                     const DynamicFilterOptions& options) {
+  CheckOptions(options);
+  CheckDepth(depth_m);
+  if (!depth_m.empty() && depth_m.size() != image_size) {
+    throw InputError("depth image size differs from the image size of the dynamic regions");
+  }
+  DynamicRegions out;
+  out.image_size_ = image_size;
+  for (const Instance& instance : instances) {
+    if (!UsesInstance(instance, options)) continue;
+    ++out.instances_used_;
+    out.regions_.push_back(BuildRegion(instance, depth_m, image_size, options));
+  }
+  return out;
+}
+
+DynamicFilterStats DynamicRegions::Label(const std::vector<cv::KeyPoint>& keypoints,
                                          const std::vector<float>& keypoint_depth,
-                                         const std::vector<Instance>& instances,
-                                         const cv::Mat& depth_m,
-                                         const DynamicFilterOptions& options,
-                                         std::vector<KeypointLabel>* labels) {
+                                         std::vector<KeypointLabel>* labels) const {
   DETSLAM_CHECK(labels != nullptr);
   DETSLAM_CHECK_MSG(labels->size() == keypoints.size(),
                     labels->size() << " labels for " << keypoints.size() << " keypoints");
   DETSLAM_CHECK_MSG(keypoint_depth.size() == keypoints.size(),
                     keypoint_depth.size() << " depths for " << keypoints.size() << " keypoints");
-  CheckOptions(options);
-  CheckDepth(depth_m);
   DynamicFilterStats stats;
-  const cv::Size image_size = InferImageSize(instances, depth_m);
-  const std::vector<InstanceRegion> regions =
-      BuildRegions(instances, depth_m, image_size, options, &stats.instances_used);
-  if (regions.empty()) return stats;
+  stats.instances_used = instances_used_;
+  if (regions_.empty()) return stats;
 
   std::vector<cv::Point> pixels(keypoints.size());
   for (size_t i = 0; i < keypoints.size(); ++i) {
@@ -254,7 +246,7 @@ DynamicFilterStats LabelDynamicKeypoints(const std::vector<cv::KeyPoint>& keypoi
   // Mask step first, over all instances, so that a mask hit wins over another instance's depth hit.
   for (size_t i = 0; i < keypoints.size(); ++i) {
     if ((*labels)[i] != KeypointLabel::kStatic) continue;
-    for (const InstanceRegion& region : regions) {
+    for (const InstanceRegion& region : regions_) {
       if (InsideDilated(region, pixels[i])) {
         (*labels)[i] = KeypointLabel::kDynamicMask;
         ++stats.rejected_mask;
@@ -264,7 +256,7 @@ DynamicFilterStats LabelDynamicKeypoints(const std::vector<cv::KeyPoint>& keypoi
   }
   for (size_t i = 0; i < keypoints.size(); ++i) {
     if ((*labels)[i] != KeypointLabel::kStatic || !ValidDepth(keypoint_depth[i])) continue;
-    for (const InstanceRegion& region : regions) {
+    for (const InstanceRegion& region : regions_) {
       if (region.box.contains(pixels[i]) && region.interval.Contains(keypoint_depth[i])) {
         (*labels)[i] = KeypointLabel::kDynamicDepth;
         ++stats.rejected_depth;
@@ -275,18 +267,10 @@ DynamicFilterStats LabelDynamicKeypoints(const std::vector<cv::KeyPoint>& keypoi
   return stats;
 }
 
-cv::Mat DynamicIgnoreMask(const std::vector<Instance>& instances, const cv::Mat& depth_m,
-                          const cv::Size& image_size, const DynamicFilterOptions& options) {
-  CheckOptions(options);
+cv::Mat DynamicRegions::IgnoreMask(const cv::Mat& depth_m) const {
   CheckDepth(depth_m);
-  if (!depth_m.empty() && depth_m.size() != image_size) {
-    throw InputError("depth image size differs from the image size given to DynamicIgnoreMask");
-  }
-  cv::Mat ignore = cv::Mat::zeros(image_size, CV_8UC1);
-  int used = 0;
-  const std::vector<InstanceRegion> regions =
-      BuildRegions(instances, depth_m, image_size, options, &used);
-  for (const InstanceRegion& region : regions) {
+  cv::Mat ignore = cv::Mat::zeros(image_size_, CV_8UC1);
+  for (const InstanceRegion& region : regions_) {
     if (!region.dilated.empty()) {
       cv::Mat target = ignore(region.roi);
       cv::bitwise_or(target, region.dilated, target);
@@ -302,6 +286,23 @@ cv::Mat DynamicIgnoreMask(const std::vector<Instance>& instances, const cv::Mat&
     }
   }
   return ignore;
+}
+
+DynamicFilterStats LabelDynamicKeypoints(const std::vector<cv::KeyPoint>& keypoints,
+                                         const std::vector<float>& keypoint_depth,
+                                         const std::vector<Instance>& instances,
+                                         const cv::Mat& depth_m,
+                                         const DynamicFilterOptions& options,
+                                         std::vector<KeypointLabel>* labels) {
+  CheckDepth(depth_m);
+  const DynamicRegions regions =
+      DynamicRegions::Build(instances, depth_m, InferImageSize(instances, depth_m), options);
+  return regions.Label(keypoints, keypoint_depth, labels);
+}
+
+cv::Mat DynamicIgnoreMask(const std::vector<Instance>& instances, const cv::Mat& depth_m,
+                          const cv::Size& image_size, const DynamicFilterOptions& options) {
+  return DynamicRegions::Build(instances, depth_m, image_size, options).IgnoreMask(depth_m);
 }
 
 }  // namespace detslam

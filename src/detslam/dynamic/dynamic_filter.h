@@ -79,6 +79,45 @@ struct DepthInterval {
 DepthInterval ObjectDepthInterval(const cv::Mat& depth_m, const cv::Mat& mask, const cv::Rect& box,
                                   const DynamicFilterOptions& options);
 
+// The dynamic instances of one frame rasterised once (dilated masks, clipped boxes, depth
+// intervals), for both forms of the filter: the pixel mask handed to the ORB extractor and the
+// keypoint labels.
+class DynamicRegions {
+ public:
+  struct Region {
+    cv::Rect roi;            // where `dilated` lies in the image
+    cv::Mat dilated;         // CV_8UC1, roi-sized, non-zero = inside the dilated mask
+    cv::Rect box;            // the instance box clipped to the image
+    DepthInterval interval;  // invalid when the depth step is off or has no depth
+  };
+
+  // The regions of the instances of a dynamic class with score >= min_score. `depth_m`: CV_32FC1
+  // metres, 0 = missing, of `image_size`; may be empty (then only the mask step runs). Throws
+  // InputError when an instance mask is neither empty nor CV_8UC1 of `image_size`.
+  static DynamicRegions Build(const std::vector<Instance>& instances, const cv::Mat& depth_m,
+                              const cv::Size& image_size, const DynamicFilterOptions& options);
+
+  // Labels each keypoint (labels->size() == keypoints.size(); existing non-static labels are
+  // kept). A keypoint's pixel is (lround(x), lround(y)); `keypoint_depth`: metres, <= 0 unknown.
+  DynamicFilterStats Label(const std::vector<cv::KeyPoint>& keypoints,
+                           const std::vector<float>& keypoint_depth,
+                           std::vector<KeypointLabel>* labels) const;
+  // The same decision as a pixel mask (CV_8UC1, 255 = reject keypoints here), for the ORB
+  // extractor to drop corners before its spatial distribution. `depth_m`: the image Build saw.
+  // A keypoint whose depth is the depth image's value at its pixel is labelled by Label iff this
+  // mask is non-zero there.
+  cv::Mat IgnoreMask(const cv::Mat& depth_m) const;
+
+  bool empty() const { return regions_.empty(); }
+  int instances_used() const { return instances_used_; }
+
+ private:
+  cv::Size image_size_;
+  std::vector<Region> regions_;
+  int instances_used_ = 0;
+};
+
+// One-shot forms (regions built for one call):
 // Labels each keypoint (labels->size() == keypoints.size(), initialised by the caller to kStatic;
 // existing non-static labels are kept). A keypoint's pixel is (lround(x), lround(y)).
 // `keypoint_depth`: metres per keypoint, <= 0 unknown. `depth_m`: CV_32FC1 metres, 0 = missing; may
@@ -91,10 +130,7 @@ DynamicFilterStats LabelDynamicKeypoints(const std::vector<cv::KeyPoint>& keypoi
                                          const DynamicFilterOptions& options,
                                          std::vector<KeypointLabel>* labels);
 
-// The same decision as a pixel mask (CV_8UC1 of `image_size`, 255 = reject keypoints here), for the
-// ORB extractor to drop corners before its spatial distribution. A keypoint whose depth is the
-// depth image's value at its pixel is rejected by LabelDynamicKeypoints iff this mask is non-zero
-// there.
+// The same decision as a pixel mask (CV_8UC1 of `image_size`, 255 = reject keypoints here).
 cv::Mat DynamicIgnoreMask(const std::vector<Instance>& instances, const cv::Mat& depth_m,
                           const cv::Size& image_size, const DynamicFilterOptions& options);
 

@@ -28,6 +28,17 @@ bool GeometricCheckOptions::Check(std::string* error) const {
   return true;
 }
 
+bool MoverCheckOptions::Check(std::string* error) const {
+  if (!threshold.Check(error)) return false;
+  std::string message;
+  if (!(radius_px > 0)) message = "radius_px must be positive";
+  if (!(depth_ratio >= 0)) message = "depth_ratio must be non-negative";
+  if (min_cluster < 0) message = "min_cluster must be non-negative";
+  if (!(carry_window_px > 0)) message = "carry_window_px must be positive";
+  if (error != nullptr) *error = message;
+  return message.empty();
+}
+
 double Median(std::vector<double> values) {
   if (values.empty()) return 0.0;
   const size_t mid = values.size() / 2;

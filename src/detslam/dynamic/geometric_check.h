@@ -24,6 +24,22 @@ struct GeometricCheckOptions {
   bool Check(std::string* error) const;
 };
 
+// The tracker's geometric check as a whole (tracking/tracker_geometric.cc): the robust threshold
+// above, then confirmation by flagged neighbours at the same depth, and the last frame's movers
+// carried forward.
+struct MoverCheckOptions {
+  // On by default: it lowered the error on the walking presets where the detector misses partly
+  // visible people and changed nothing on the static benchmarks (docs/BENCHMARKS.md).
+  bool enabled = true;
+  GeometricCheckOptions threshold;  // robust threshold on reprojection residuals (pixels / scale)
+  double radius_px = 30.0;          // cluster / spread radius around a flagged keypoint
+  double depth_ratio = 0.1;         // same object: depths within this fraction
+  int min_cluster = 3;              // flagged neighbours needed to confirm a mover
+  double carry_window_px = 15.0;    // search window for last frame's movers (pixels, level 0)
+
+  bool Check(std::string* error) const;
+};
+
 struct GeometricCheckResult {
   int samples = 0;         // static keypoints with a valid residual
   double median = 0.0;     // median residual of those

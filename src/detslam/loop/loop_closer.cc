@@ -13,6 +13,7 @@
 #include "detslam/mapping/map_bundle.h"
 #include "detslam/optim/pose_graph.h"
 #include "detslam/optim/pose_optimizer.h"
+#include "detslam/tracking/keypoint_observation.h"
 
 namespace detslam {
 
@@ -28,21 +29,21 @@ bool LoopClosingOptions::Check(std::string* error) const {
   return os.str().empty();
 }
 
-LoopCloser::LoopCloser(const PinholeCamera& camera, LoopClosingOptions options, Map* map)
-    : camera_(camera), options_(options), map_(map), rng_(options.seed) {
+LoopCloser::LoopCloser(const PinholeCamera& camera, LoopClosingOptions options)
+    : camera_(camera), options_(options), rng_(options.seed) {
   std::string error;
   DETSLAM_CHECK_MSG(options_.Check(&error), "invalid LoopClosingOptions: " << error);
 }
 
-LoopClosingResult LoopCloser::Process(KeyFrameId kf_id) {
+LoopClosingResult LoopCloser::Process(Map& map, KeyFrameId kf_id) {
   LoopClosingResult result;
   result.keyframe = kf_id;
-  if (!options_.enabled || !map_->HasKeyFrame(kf_id)) return result;
+  if (!options_.enabled || !map.HasKeyFrame(kf_id)) return result;
   if (last_loop_kf_ != kNoKeyFrame && kf_id - last_loop_kf_ < 5) return result;
-  const KeyFrame& kf = map_->keyframe(kf_id);
+  const KeyFrame& kf = map.keyframe(kf_id);
   const Eigen::Vector3d center = kf.Center();
   std::vector<std::pair<double, KeyFrameId>> near;
-  for (const auto& [id, other] : map_->keyframes()) {
+  for (const auto& [id, other] : map.keyframes()) {
     if (id > kf_id - options_.min_keyframe_gap) break;  // ids ascend
     if (kf.covisibility.count(id)) continue;
     const double d = (other.Center() - center).norm();
@@ -54,8 +55,8 @@ LoopClosingResult LoopCloser::Process(KeyFrameId kf_id) {
   for (const auto& [d, candidate] : near) {
     (void)d;
     Verified loop;
-    if (!Verify(kf_id, candidate, &loop)) continue;
-    Correct(kf_id, loop, &result);
+    if (!Verify(map, kf_id, candidate, &loop)) continue;
+    Correct(map, kf_id, loop, &result);
     result.closed = true;
     result.candidate = candidate;
     result.inliers = loop.inliers;
@@ -68,15 +69,15 @@ LoopClosingResult LoopCloser::Process(KeyFrameId kf_id) {
   return result;
 }
 
-bool LoopCloser::Verify(KeyFrameId kf_id, KeyFrameId candidate_id, Verified* out) {
-  const KeyFrame& kf = map_->keyframe(kf_id);
+bool LoopCloser::Verify(const Map& map, KeyFrameId kf_id, KeyFrameId candidate_id, Verified* out) {
+  const KeyFrame& kf = map.keyframe(kf_id);
   const FrameFeatures& f = *kf.features;
-  std::vector<LandmarkId> matched = MatchKeyFrameLandmarks(map_->keyframe(candidate_id), f, 0.9, kThHigh);
+  std::vector<LandmarkId> matched = MatchKeyFrameLandmarks(map.keyframe(candidate_id), f, 0.9, kThHigh);
   std::vector<Eigen::Vector3d> world, cam;
   std::vector<size_t> kp;
   for (size_t i = 0; i < f.size(); ++i) {
-    if (matched[i] == kNoLandmark || f.depth[i] <= 0 || !map_->HasLandmark(matched[i])) continue;
-    world.push_back(map_->landmark(matched[i]).position);
+    if (matched[i] == kNoLandmark || f.depth[i] <= 0 || !map.HasLandmark(matched[i])) continue;
+    world.push_back(map.landmark(matched[i]).position);
     cam.push_back(camera_.Unproject(f.undist[i], f.depth[i]));
     kp.push_back(i);
   }
@@ -99,12 +100,7 @@ bool LoopCloser::Verify(KeyFrameId kf_id, KeyFrameId candidate_id, Verified* out
     std::vector<size_t> idx;
     for (size_t i = 0; i < f.size(); ++i) {
       if (assoc[i] == kNoLandmark) continue;
-      PoseObservation o;
-      o.point_world = map_->landmark(assoc[i]).position;
-      o.uv = f.undist[i];
-      o.u_right = f.u_right[i];
-      o.inv_sigma2 = map_->scale().inv_level_sigma2[static_cast<size_t>(f.keypoints[i].octave)];
-      obs.push_back(o);
+      obs.push_back(KeypointObservation(f, i, map.landmark(assoc[i]).position, map.scale()));
       idx.push_back(i);
     }
     if (obs.size() < 3) return 0;
@@ -116,14 +112,14 @@ bool LoopCloser::Verify(KeyFrameId kf_id, KeyFrameId candidate_id, Verified* out
     return r.num_inliers;
   };
   if (optimise() < options_.min_ransac_inliers) return false;
-  std::vector<KeyFrameId> neighbourhood = map_->BestCovisibles(candidate_id, 10);
+  std::vector<KeyFrameId> neighbourhood = map.BestCovisibles(candidate_id, 10);
   neighbourhood.push_back(candidate_id);
   std::set<LandmarkId> seen(assoc.begin(), assoc.end());
   std::vector<ProjectionCandidate> candidates;
   for (KeyFrameId n : neighbourhood) {
-    for (LandmarkId lm : map_->keyframe(n).landmarks) {
-      if (lm != kNoLandmark && map_->HasLandmark(lm) && seen.insert(lm).second) {
-        candidates.push_back(CandidateFromLandmark(map_->landmark(lm)));
+    for (LandmarkId lm : map.keyframe(n).landmarks) {
+      if (lm != kNoLandmark && map.HasLandmark(lm) && seen.insert(lm).second) {
+        candidates.push_back(CandidateFromLandmark(map.landmark(lm)));
       }
     }
   }
@@ -132,7 +128,7 @@ bool LoopCloser::Verify(KeyFrameId kf_id, KeyFrameId candidate_id, Verified* out
   ProjectionSearchOptions po;
   po.window = 10;
   po.ratio = 0.9;
-  const std::vector<int> m = SearchByProjection(camera_, map_->scale(), f, pose, candidates, taken, po);
+  const std::vector<int> m = SearchByProjection(camera_, map.scale(), f, pose, candidates, taken, po);
   for (size_t c = 0; c < candidates.size(); ++c) {
     if (m[c] >= 0) assoc[static_cast<size_t>(m[c])] = candidates[c].landmark;
   }
@@ -146,21 +142,21 @@ bool LoopCloser::Verify(KeyFrameId kf_id, KeyFrameId candidate_id, Verified* out
   return true;
 }
 
-void LoopCloser::Correct(KeyFrameId kf_id, const Verified& loop, LoopClosingResult* result) {
+void LoopCloser::Correct(Map& map, KeyFrameId kf_id, const Verified& loop, LoopClosingResult* result) {
   // Poses and positions before the correction.
   std::map<KeyFrameId, Rigid3d> old_pose;
-  for (const auto& [id, k] : map_->keyframes()) old_pose[id] = k.cam_from_world;
+  for (const auto& [id, k] : map.keyframes()) old_pose[id] = k.cam_from_world;
   std::map<LandmarkId, Eigen::Vector3d> old_position;
-  for (const auto& [id, lm] : map_->landmarks()) old_position[id] = lm.position;
+  for (const auto& [id, lm] : map.landmarks()) old_position[id] = lm.position;
 
   // The keyframe's neighbourhood moves rigidly with it: world_new_from_world_old.
   const Rigid3d correction = loop.cam_from_world.Inverse() * old_pose.at(kf_id);
-  std::vector<KeyFrameId> group = map_->BestCovisibles(kf_id, 1000);
+  std::vector<KeyFrameId> group = map.BestCovisibles(kf_id, 1000);
   group.push_back(kf_id);
   const std::set<KeyFrameId> in_group(group.begin(), group.end());
   std::map<KeyFrameId, std::set<KeyFrameId>> connected_before;
   for (KeyFrameId g : group) {
-    for (const auto& [n, w] : map_->keyframe(g).covisibility) {
+    for (const auto& [n, w] : map.keyframe(g).covisibility) {
       (void)w;
       connected_before[g].insert(n);
     }
@@ -169,33 +165,33 @@ void LoopCloser::Correct(KeyFrameId kf_id, const Verified& loop, LoopClosingResu
   for (KeyFrameId g : group) initial[g] = old_pose.at(g) * correction.Inverse();
 
   // Fuse the keyframe's landmarks into the loop landmarks they matched.
-  KeyFrame& kf = map_->keyframe(kf_id);
+  KeyFrame& kf = map.keyframe(kf_id);
   for (size_t i = 0; i < loop.matched.size(); ++i) {
     const LandmarkId into = loop.matched[i];
-    if (into == kNoLandmark || !map_->HasLandmark(into)) continue;
+    if (into == kNoLandmark || !map.HasLandmark(into)) continue;
     const LandmarkId current = kf.landmarks[i];
     if (current == into) continue;
-    if (current != kNoLandmark && map_->HasLandmark(current)) {
-      map_->ReplaceLandmark(current, into);
-    } else if (!map_->landmark(into).observations.count(kf_id)) {
-      map_->AddObservation(into, kf_id, i);
+    if (current != kNoLandmark && map.HasLandmark(current)) {
+      map.ReplaceLandmark(current, into);
+    } else if (!map.landmark(into).observations.count(kf_id)) {
+      map.AddObservation(into, kf_id, i);
     } else {
       continue;
     }
     ++result->fused;
   }
-  for (KeyFrameId g : group) map_->UpdateConnections(g);
+  for (KeyFrameId g : group) map.UpdateConnections(g);
 
   // Essential graph: spanning tree, strong covisibility, and the new loop connections.
   PoseGraphProblem problem;
   std::map<KeyFrameId, size_t> node;
-  for (const auto& [id, k] : map_->keyframes()) {
+  for (const auto& [id, k] : map.keyframes()) {
     (void)k;
     node[id] = problem.nodes.size();
     PoseGraphProblem::Node n;
     n.id = id;
     n.cam_from_world = initial.at(id);
-    n.fixed = id == map_->first_keyframe();
+    n.fixed = id == map.first_keyframe();
     problem.nodes.push_back(n);
   }
   std::set<std::pair<KeyFrameId, KeyFrameId>> added;
@@ -211,12 +207,12 @@ void LoopCloser::Correct(KeyFrameId kf_id, const Verified& loop, LoopClosingResu
   // Loop edges first (measured with the corrected group poses).
   add_edge(kf_id, loop.candidate, initial);
   for (KeyFrameId g : group) {
-    for (const auto& [n, w] : map_->keyframe(g).covisibility) {
+    for (const auto& [n, w] : map.keyframe(g).covisibility) {
       (void)w;
       if (!in_group.count(n) && !connected_before[g].count(n)) add_edge(g, n, initial);
     }
   }
-  for (const auto& [id, k] : map_->keyframes()) {
+  for (const auto& [id, k] : map.keyframes()) {
     if (k.parent != kNoKeyFrame) add_edge(id, k.parent, old_pose);
     for (const auto& [n, w] : k.covisibility) {
       if (w >= options_.essential_min_weight) add_edge(id, n, old_pose);
@@ -224,23 +220,23 @@ void LoopCloser::Correct(KeyFrameId kf_id, const Verified& loop, LoopClosingResu
   }
   const PoseGraphSummary s = SolvePoseGraph(&problem, PoseGraphOptions());
   if (!s.usable) spdlog::warn("loop closing: pose graph optimisation did not converge; using its last state");
-  for (const PoseGraphProblem::Node& n : problem.nodes) map_->keyframe(n.id).cam_from_world = n.cam_from_world;
+  for (const PoseGraphProblem::Node& n : problem.nodes) map.keyframe(n.id).cam_from_world = n.cam_from_world;
 
   // Every landmark moves with its reference keyframe.
   for (const auto& [id, pos] : old_position) {
-    if (!map_->HasLandmark(id)) continue;
-    Landmark& lm = map_->landmark(id);
+    if (!map.HasLandmark(id)) continue;
+    Landmark& lm = map.landmark(id);
     KeyFrameId ref = lm.reference_keyframe;
-    if (!map_->HasKeyFrame(ref) || !old_pose.count(ref)) {
+    if (!map.HasKeyFrame(ref) || !old_pose.count(ref)) {
       if (lm.observations.empty()) continue;
       ref = lm.observations.begin()->first;
     }
     if (!old_pose.count(ref)) continue;
-    lm.position = map_->keyframe(ref).cam_from_world.Inverse() * (old_pose.at(ref) * pos);
-    map_->UpdateLandmarkGeometry(id);
+    lm.position = map.keyframe(ref).cam_from_world.Inverse() * (old_pose.at(ref) * pos);
+    map.UpdateLandmarkGeometry(id);
   }
-  if (options_.global_ba_iterations > 0) GlobalBundleAdjustment(camera_, options_.global_ba_iterations, map_);
-  result->correction_m = (map_->keyframe(kf_id).Center() - old_pose.at(kf_id).Inverse().translation()).norm();
+  if (options_.global_ba_iterations > 0) GlobalBundleAdjustment(camera_, options_.global_ba_iterations, &map);
+  result->correction_m = (map.keyframe(kf_id).Center() - old_pose.at(kf_id).Inverse().translation()).norm();
   result->old_poses = std::move(old_pose);
 }
 

@@ -49,10 +49,11 @@ struct LoopClosingResult {
 
 class LoopCloser {
  public:
-  LoopCloser(const PinholeCamera& camera, LoopClosingOptions options, Map* map);
+  LoopCloser(const PinholeCamera& camera, LoopClosingOptions options);
 
-  // Looks for and closes a loop at keyframe `kf` (which must exist). Deterministic.
-  LoopClosingResult Process(KeyFrameId kf);
+  // Looks for and closes a loop at keyframe `kf` of `map` (the caller holds the map store's write
+  // access for the whole step). Deterministic.
+  LoopClosingResult Process(Map& map, KeyFrameId kf);
 
   int loops_closed() const { return loops_closed_; }
 
@@ -63,12 +64,11 @@ class LoopCloser {
     std::vector<LandmarkId> matched;         // per keypoint of the current keyframe
     int inliers = 0;
   };
-  bool Verify(KeyFrameId kf, KeyFrameId candidate, Verified* out);
-  void Correct(KeyFrameId kf, const Verified& loop, LoopClosingResult* result);
+  bool Verify(const Map& map, KeyFrameId kf, KeyFrameId candidate, Verified* out);
+  void Correct(Map& map, KeyFrameId kf, const Verified& loop, LoopClosingResult* result);
 
   PinholeCamera camera_;
   LoopClosingOptions options_;
-  Map* map_;
   Rng rng_;
   KeyFrameId last_loop_kf_ = kNoKeyFrame;
   int loops_closed_ = 0;

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "detslam/core/check.h"
+
 namespace detslam {
 
 ScaleInfo ScaleInfo::Geometric(double scale_factor, int num_levels) {
@@ -29,27 +31,42 @@ ImageBounds UndistortedBounds(const PinholeCamera& camera) {
   return b;
 }
 
+std::vector<float> SampleKeypointDepth(const std::vector<cv::KeyPoint>& keypoints,
+                                       const cv::Mat& depth_m) {
+  std::vector<float> depth(keypoints.size(), -1.0f);
+  for (size_t i = 0; i < keypoints.size(); ++i) {
+    const int u = static_cast<int>(std::lround(keypoints[i].pt.x));
+    const int v = static_cast<int>(std::lround(keypoints[i].pt.y));
+    if (depth_m.empty() || u < 0 || v < 0 || u >= depth_m.cols || v >= depth_m.rows) continue;
+    const float d = depth_m.at<float>(v, u);
+    if (d > 0 && std::isfinite(d)) depth[i] = d;
+  }
+  return depth;
+}
+
 std::shared_ptr<FrameFeatures> BuildFrameFeatures(const PinholeCamera& camera,
                                                   std::vector<cv::KeyPoint> keypoints,
                                                   cv::Mat descriptors, const cv::Mat& depth_m) {
+  std::vector<float> depth = SampleKeypointDepth(keypoints, depth_m);
+  return BuildFrameFeatures(camera, std::move(keypoints), std::move(descriptors), std::move(depth));
+}
+
+std::shared_ptr<FrameFeatures> BuildFrameFeatures(const PinholeCamera& camera,
+                                                  std::vector<cv::KeyPoint> keypoints,
+                                                  cv::Mat descriptors, std::vector<float> depth) {
+  DETSLAM_CHECK_MSG(depth.size() == keypoints.size(),
+                    depth.size() << " depths for " << keypoints.size() << " keypoints");
   auto f = std::make_shared<FrameFeatures>();
   const size_t n = keypoints.size();
   std::vector<Eigen::Vector2d> distorted(n);
   for (size_t i = 0; i < n; ++i) distorted[i] = {keypoints[i].pt.x, keypoints[i].pt.y};
   f->undist = camera.Undistort(distorted);
-  f->depth.assign(n, -1.0f);
+  f->depth = std::move(depth);
   f->u_right.assign(n, -1.0f);
   for (size_t i = 0; i < n; ++i) {
-    const int u = static_cast<int>(std::lround(keypoints[i].pt.x));
-    const int v = static_cast<int>(std::lround(keypoints[i].pt.y));
-    if (depth_m.empty() || u < 0 || v < 0 || u >= depth_m.cols || v >= depth_m.rows) continue;
-    const float d = depth_m.at<float>(v, u);
-    if (d > 0 && std::isfinite(d)) {
-      f->depth[i] = d;
-      f->u_right[i] = static_cast<float>(f->undist[i].x() - camera.bf / d);
-    }
+    const float d = f->depth[i];
+    if (d > 0) f->u_right[i] = static_cast<float>(f->undist[i].x() - camera.bf / d);
   }
-  f->labels.assign(n, KeypointLabel::kStatic);
   std::vector<int> octaves(n);
   for (size_t i = 0; i < n; ++i) octaves[i] = keypoints[i].octave;
   f->grid = std::make_shared<KeypointGrid>(f->undist, octaves, UndistortedBounds(camera));

@@ -42,8 +42,8 @@ struct FrameFeatures {
   std::vector<float> depth;              // metres, <= 0 when unknown
   std::vector<float> u_right;            // u - bf/depth, < 0 when unknown
   cv::Mat descriptors;                   // N x 32, CV_8UC1
-  std::vector<KeypointLabel> labels;     // label per keypoint: all kStatic (rejected ones below)
-  // Keypoints the dynamic filter rejected, kept for diagnostics only (tracking never sees them).
+  // Keypoints the Det-SLAM stage rejected, with their labels, kept for diagnostics only (tracking
+  // never sees them; every keypoint above is static as far as the segmenter knows).
   std::vector<cv::KeyPoint> rejected_keypoints;
   std::vector<KeypointLabel> rejected_labels;
   std::shared_ptr<const KeypointGrid> grid;  // area queries over `undist`
@@ -70,10 +70,20 @@ struct Frame {
 // Bounds of undistorted keypoint positions (the image corners undistorted).
 ImageBounds UndistortedBounds(const PinholeCamera& camera);
 
+// Each keypoint's depth from the depth image (CV_32FC1, metres; may be empty), read at the
+// detected (distorted) pixel (lround(x), lround(y)) as ORB-SLAM does; -1 where missing, zero or
+// not finite.
+std::vector<float> SampleKeypointDepth(const std::vector<cv::KeyPoint>& keypoints,
+                                       const cv::Mat& depth_m);
+
 // Builds a frame's features from extraction output and the depth image (CV_32FC1, metres):
-// depth is read at the detected (distorted) pixel, as ORB-SLAM does, and keypoints are undistorted.
+// depth as SampleKeypointDepth reads it; keypoints are undistorted.
 std::shared_ptr<FrameFeatures> BuildFrameFeatures(const PinholeCamera& camera,
                                                   std::vector<cv::KeyPoint> keypoints,
                                                   cv::Mat descriptors, const cv::Mat& depth_m);
+// The same with each keypoint's depth already sampled (SampleKeypointDepth).
+std::shared_ptr<FrameFeatures> BuildFrameFeatures(const PinholeCamera& camera,
+                                                  std::vector<cv::KeyPoint> keypoints,
+                                                  cv::Mat descriptors, std::vector<float> depth);
 
 }  // namespace detslam

@@ -16,7 +16,6 @@ std::shared_ptr<FrameFeatures> Features(size_t n, uint8_t fill) {
     f->u_right.push_back(0.0f);
   }
   f->descriptors = cv::Mat(static_cast<int>(n), 32, CV_8UC1, cv::Scalar(fill));
-  f->labels.assign(n, KeypointLabel::kStatic);
   return f;
 }
 

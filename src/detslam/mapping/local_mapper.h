@@ -5,12 +5,12 @@
 #pragma once
 
 #include <deque>
-#include <mutex>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include "detslam/map/map.h"
+#include "detslam/map/map_store.h"
 
 namespace detslam {
 
@@ -50,24 +50,23 @@ struct LocalMappingSummary {
 
 class LocalMapper {
  public:
-  LocalMapper(const PinholeCamera& camera, LocalMapperOptions options, Map* map);
+  LocalMapper(const PinholeCamera& camera, LocalMapperOptions options);
 
-  // Processes a keyframe just inserted by the tracker. Deterministic. With `map_mutex`, the map
-  // is locked for every step except the bundle-adjustment solve, which runs on a copy of the
-  // problem while the tracker may use the map (the result is applied under the lock).
-  LocalMappingSummary ProcessKeyFrame(KeyFrameId kf, std::mutex* map_mutex = nullptr);
+  // Processes a keyframe just inserted by the tracker. Deterministic. Every step holds the
+  // store's write access except the bundle-adjustment solve, which runs on a snapshot while the
+  // tracker may use the map (MapStore::ComputeOutsideLock).
+  LocalMappingSummary ProcessKeyFrame(KeyFrameId kf, MapStore* store);
 
  private:
-  void CullLandmarks(KeyFrameId current, LocalMappingSummary* summary);
-  void TriangulateNewLandmarks(KeyFrameId current, LocalMappingSummary* summary);  // triangulate.cc
-  void FuseWithNeighbours(KeyFrameId current, LocalMappingSummary* summary);
-  void LocalBundleAdjustment(KeyFrameId current, LocalMappingSummary* summary,
-                             std::unique_lock<std::mutex>* lock);
-  void CullKeyFrames(KeyFrameId current, LocalMappingSummary* summary);
+  void CullLandmarks(Map& map, KeyFrameId current, LocalMappingSummary* summary);
+  void TriangulateNewLandmarks(Map& map, KeyFrameId current,
+                               LocalMappingSummary* summary);  // triangulate.cc
+  void FuseWithNeighbours(Map& map, KeyFrameId current, LocalMappingSummary* summary);
+  void LocalBundleAdjustment(MapStore* store, KeyFrameId current, LocalMappingSummary* summary);
+  void CullKeyFrames(Map& map, KeyFrameId current, LocalMappingSummary* summary);
 
   PinholeCamera camera_;
   LocalMapperOptions options_;
-  Map* map_;
   std::deque<LandmarkId> recent_landmarks_;
 };
 

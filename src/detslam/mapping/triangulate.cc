@@ -60,17 +60,17 @@ bool WithinGate(const PinholeCamera& camera, const ScaleInfo& scale, const KeyFr
 
 }  // namespace
 
-void LocalMapper::TriangulateNewLandmarks(KeyFrameId current, LocalMappingSummary* summary) {
-  const ScaleInfo& scale = map_->scale();
+void LocalMapper::TriangulateNewLandmarks(Map& map, KeyFrameId current, LocalMappingSummary* summary) {
+  const ScaleInfo& scale = map.scale();
   const double close_depth = camera_.CloseDepthThreshold();
   const double ratio_factor = 1.5 * (scale.scale_factors.size() > 1 ? scale.scale_factors[1] : 1.2);
   MatchOptions match;
   match.ratio = 0.6;
   match.max_distance = kThLow;
   for (KeyFrameId other :
-       map_->BestCovisibles(current, static_cast<size_t>(options_.triangulation_neighbours))) {
-    const KeyFrame& kf1 = map_->keyframe(current);
-    const KeyFrame& kf2 = map_->keyframe(other);
+       map.BestCovisibles(current, static_cast<size_t>(options_.triangulation_neighbours))) {
+    const KeyFrame& kf1 = map.keyframe(current);
+    const KeyFrame& kf2 = map.keyframe(other);
     if ((kf1.Center() - kf2.Center()).norm() < camera_.Baseline()) continue;  // too close
     const std::vector<int> c1 = Candidates(kf1, close_depth), c2 = Candidates(kf2, close_depth);
     if (c1.empty() || c2.empty()) continue;
@@ -83,9 +83,9 @@ void LocalMapper::TriangulateNewLandmarks(KeyFrameId current, LocalMappingSummar
     for (const cv::DMatch& m : MatchBruteForce(kp1, d1, kp2, d2, match)) {
       const size_t i1 = static_cast<size_t>(c1[static_cast<size_t>(m.queryIdx)]);
       const size_t i2 = static_cast<size_t>(c2[static_cast<size_t>(m.trainIdx)]);
-      if (map_->keyframe(current).landmarks[i1] != kNoLandmark)
+      if (map.keyframe(current).landmarks[i1] != kNoLandmark)
         continue;  // taken by an earlier pair
-      if (map_->keyframe(other).landmarks[i2] != kNoLandmark) continue;
+      if (map.keyframe(other).landmarks[i2] != kNoLandmark) continue;
       const Eigen::Vector2d xn1 = PixelToNormalized(camera_, f1.undist[i1]);
       const Eigen::Vector2d xn2 = PixelToNormalized(camera_, f2.undist[i2]);
       const double cos_parallax = CosParallaxRays(kf1.cam_from_world, kf2.cam_from_world, xn1, xn2);
@@ -103,11 +103,11 @@ void LocalMapper::TriangulateNewLandmarks(KeyFrameId current, LocalMappingSummar
           scale.scale_factors[static_cast<size_t>(f2.keypoints[i2].octave)];
       if (ratio_dist * ratio_factor < ratio_octave || ratio_dist > ratio_octave * ratio_factor)
         continue;
-      const LandmarkId lm = map_->AddLandmark(p, current);
-      map_->AddObservation(lm, current, i1);
-      map_->AddObservation(lm, other, i2);
-      map_->UpdateLandmarkDescriptor(lm);
-      map_->UpdateLandmarkGeometry(lm);
+      const LandmarkId lm = map.AddLandmark(p, current);
+      map.AddObservation(lm, current, i1);
+      map.AddObservation(lm, other, i2);
+      map.UpdateLandmarkDescriptor(lm);
+      map.UpdateLandmarkGeometry(lm);
       recent_landmarks_.push_back(lm);
       ++summary->triangulated;
     }

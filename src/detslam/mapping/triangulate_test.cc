@@ -54,7 +54,6 @@ Scene Build(Map* map, double baseline, KeyFrameId* first, KeyFrameId* second) {
       f->u_right.push_back(close ? static_cast<float>(uv.x() - camera.bf / pc.z()) : -1.0f);
     }
     f->descriptors = descriptors.clone();
-    f->labels.assign(points.size(), KeypointLabel::kStatic);
     kf.features = f;
     kf.labels.assign(points.size(), KeypointLabel::kStatic);
     if (k == 1) kf.labels[70] = KeypointLabel::kGeometric;
@@ -80,12 +79,14 @@ LocalMapperOptions TriangulationOnly() {
 }
 
 TEST(Triangulation, NewLandmarksForFarPointsWithoutDepth) {
-  Map map(TestScale());
+  MapStore store(TestScale());
   KeyFrameId a, b;
-  const Scene scene = Build(&map, 0.3, &a, &b);
-  LocalMapper mapper(PinholeCamera(), TriangulationOnly(), &map);
-  const size_t before = map.NumLandmarks();
-  const LocalMappingSummary summary = mapper.ProcessKeyFrame(b);
+  const Scene scene = Build(&*store.Write(), 0.3, &a, &b);
+  LocalMapper mapper(PinholeCamera(), TriangulationOnly());
+  const size_t before = store.Read()->NumLandmarks();
+  const LocalMappingSummary summary = mapper.ProcessKeyFrame(b, &store);
+  const MapStore::ReadAccess access = store.Read();
+  const Map& map = *access;
   EXPECT_EQ(summary.triangulated, 50);
   EXPECT_EQ(map.NumLandmarks(), before + 50);
   const KeyFrame& kb = map.keyframe(b);
@@ -102,21 +103,21 @@ TEST(Triangulation, NewLandmarksForFarPointsWithoutDepth) {
 
 TEST(Triangulation, NothingWithTooShortABaselineOrWhenOff) {
   {
-    Map map(TestScale());
+    MapStore store(TestScale());
     KeyFrameId a, b;
-    Build(&map, 0.05, &a, &b);  // below the sensor's 7.5 cm baseline
-    LocalMapper mapper(PinholeCamera(), TriangulationOnly(), &map);
-    EXPECT_EQ(mapper.ProcessKeyFrame(b).triangulated, 0);
+    Build(&*store.Write(), 0.05, &a, &b);  // below the sensor's 7.5 cm baseline
+    LocalMapper mapper(PinholeCamera(), TriangulationOnly());
+    EXPECT_EQ(mapper.ProcessKeyFrame(b, &store).triangulated, 0);
   }
-  Map map(TestScale());
+  MapStore store(TestScale());
   KeyFrameId a, b;
-  Build(&map, 0.3, &a, &b);
+  Build(&*store.Write(), 0.3, &a, &b);
   LocalMapperOptions off = TriangulationOnly();
   off.triangulate = false;
-  LocalMapper mapper(PinholeCamera(), off, &map);
-  const size_t before = map.NumLandmarks();
-  EXPECT_EQ(mapper.ProcessKeyFrame(b).triangulated, 0);
-  EXPECT_EQ(map.NumLandmarks(), before);
+  LocalMapper mapper(PinholeCamera(), off);
+  const size_t before = store.Read()->NumLandmarks();
+  EXPECT_EQ(mapper.ProcessKeyFrame(b, &store).triangulated, 0);
+  EXPECT_EQ(store.Read()->NumLandmarks(), before);
 }
 
 }  // namespace

@@ -11,10 +11,9 @@
 #include <thread>
 
 #include "detslam/core/atomic_file.h"
-#include "detslam/dynamic/instance_memory.h"
-#include "detslam/dynamic/mask_propagation.h"
 #include "detslam/io/ply.h"
 #include "detslam/pipeline/bounded_queue.h"
+#include "detslam/pipeline/stage_threads.h"
 
 namespace detslam {
 namespace {
@@ -33,7 +32,7 @@ void WriteOutputs(const RgbdDataset& dataset, const Settings& settings, const Ru
   WriteTumTrajectory((out / "trajectory.txt").string(), slam.FrameTrajectory(), header);
   WriteTumTrajectory((out / "keyframes.txt").string(), slam.KeyFrameTrajectory(), "detslam keyframes of " + dataset.dir());
   std::vector<Eigen::Vector3d> points;
-  for (const auto& [id, lm] : slam.map().landmarks()) {
+  for (const auto& [id, lm] : slam.ReadMap()->landmarks()) {
     (void)id;
     points.push_back(lm.position);
   }
@@ -41,7 +40,7 @@ void WriteOutputs(const RgbdDataset& dataset, const Settings& settings, const Ru
   nlohmann::json j;
   j["dataset"] = dataset.dir();
   j["settings"] = settings.source;
-  j["mode"] = options.threaded ? (options.slam.mapping_thread ? "threaded (mapping thread)" : "threaded") : "sequential";
+  j["mode"] = options.threaded ? (options.mapping_thread ? "threaded (mapping thread)" : "threaded") : "sequential";
   j["camera"] = {{"fx", settings.camera.fx}, {"fy", settings.camera.fy}, {"cx", settings.camera.cx},
                  {"cy", settings.camera.cy}, {"depth_map_factor", settings.camera.depth_map_factor},
                  {"bf", settings.camera.bf}, {"th_depth", settings.camera.th_depth},
@@ -59,10 +58,11 @@ void WriteOutputs(const RgbdDataset& dataset, const Settings& settings, const Ru
   j["loops_closed"] = summary.loops;
   j["wall_s"] = summary.wall_s;
   j["segmenter"] = summary.segmenter.empty() ? "none" : summary.segmenter;
-  j["dynamic_filter"] = {{"classes", options.slam.dynamic.dynamic_classes}, {"alpha", options.slam.dynamic.alpha},
-                         {"depth_step", options.slam.dynamic.depth_step}, {"mask_dilation_px", options.slam.dynamic.mask_dilation_px},
-                         {"premask", options.slam.dynamic_premask}, {"memory_frames", options.slam.dynamic_memory_frames},
-                         {"geometric_check", options.slam.tracker.geometric_check}, {"segment_every", options.segment_every}};
+  const DetSlamOptions& dyn = options.slam.dynamic;
+  j["dynamic_filter"] = {{"classes", dyn.filter.dynamic_classes}, {"alpha", dyn.filter.alpha},
+                         {"depth_step", dyn.filter.depth_step}, {"mask_dilation_px", dyn.filter.mask_dilation_px},
+                         {"premask", dyn.premask}, {"memory_frames", dyn.memory_frames},
+                         {"geometric_check", dyn.geometric.enabled}, {"segment_every", dyn.segment_every}};
   j["timings"] = {{"segmentation", StatsJson(summary.segmentation)}, {"extraction", StatsJson(summary.extraction)}, {"tracking", StatsJson(summary.tracking)},
                   {"local_mapping_per_keyframe", StatsJson(summary.mapping)}, {"total_per_frame", StatsJson(summary.total)}};
   nlohmann::json per_frame = nlohmann::json::array();
@@ -98,22 +98,24 @@ SlamOptions SlamOptionsFromSettings(const Settings& settings, uint64_t seed) {
   o.loop.enabled = settings.GetBool("LoopClosing.Enabled", o.loop.enabled);
   o.loop.candidate_radius_m = settings.GetDouble("LoopClosing.CandidateRadius", o.loop.candidate_radius_m);
   o.loop.global_ba_iterations = settings.GetInt("LoopClosing.GlobalBAIterations", o.loop.global_ba_iterations);
-  o.dynamic.alpha = settings.GetDouble("Dynamic.Alpha", o.dynamic.alpha);
-  o.dynamic.depth_step = settings.GetBool("Dynamic.DepthStep", o.dynamic.depth_step);
-  o.dynamic.mask_dilation_px = settings.GetInt("Dynamic.MaskDilation", o.dynamic.mask_dilation_px);
-  o.dynamic.min_score = static_cast<float>(settings.GetDouble("Dynamic.MinScore", o.dynamic.min_score));
-  o.dynamic_premask = settings.GetBool("Dynamic.PreMask", o.dynamic_premask);
-  o.dynamic_memory_frames = settings.GetInt("Dynamic.MemoryFrames", o.dynamic_memory_frames);
-  o.tracker.geometric_check = settings.GetBool("Dynamic.GeometricCheck", o.tracker.geometric_check);
-  o.tracker.geometric.k = settings.GetDouble("Dynamic.GeometricK", o.tracker.geometric.k);
-  o.tracker.geometric.min_threshold = settings.GetDouble("Dynamic.GeometricMinResidual", o.tracker.geometric.min_threshold);
+  DetSlamOptions& d = o.dynamic;
+  d.filter.alpha = settings.GetDouble("Dynamic.Alpha", d.filter.alpha);
+  d.filter.depth_step = settings.GetBool("Dynamic.DepthStep", d.filter.depth_step);
+  d.filter.mask_dilation_px = settings.GetInt("Dynamic.MaskDilation", d.filter.mask_dilation_px);
+  d.filter.min_score = static_cast<float>(settings.GetDouble("Dynamic.MinScore", d.filter.min_score));
+  d.premask = settings.GetBool("Dynamic.PreMask", d.premask);
+  d.memory_frames = settings.GetInt("Dynamic.MemoryFrames", d.memory_frames);
+  d.segment_every = settings.GetInt("Segmentation.EveryK", d.segment_every);
+  d.geometric.enabled = settings.GetBool("Dynamic.GeometricCheck", d.geometric.enabled);
+  d.geometric.threshold.k = settings.GetDouble("Dynamic.GeometricK", d.geometric.threshold.k);
+  d.geometric.threshold.min_threshold = settings.GetDouble("Dynamic.GeometricMinResidual", d.geometric.threshold.min_threshold);
   const std::string classes = settings.GetString("Dynamic.Classes", "");
   if (!classes.empty()) {
-    o.dynamic.dynamic_classes.clear();
+    o.dynamic.filter.dynamic_classes.clear();
     std::string cur;
     for (char c : classes + ",") {
       if (c == ',') {
-        if (!cur.empty()) o.dynamic.dynamic_classes.push_back(cur);
+        if (!cur.empty()) o.dynamic.filter.dynamic_classes.push_back(cur);
         cur.clear();
       } else if (c != ' ') {
         cur.push_back(c);
@@ -145,12 +147,14 @@ class RunRecorder {
   RunSummary Finish(const RgbdDataset& dataset, const Settings& settings, const RunOptions& options,
                     SlamSystem& slam, std::chrono::steady_clock::time_point start,
                     const Segmenter* segmenter) {
-    slam.Finish();  // drain the mapping thread before reading the map
     if (segmenter != nullptr) summary_.segmenter = segmenter->name();
     summary_.segmentation = ComputeErrorStats(seg_);
     summary_.loops = static_cast<size_t>(slam.loops_closed());
-    summary_.keyframes = slam.map().NumKeyFrames();
-    summary_.landmarks = slam.map().NumLandmarks();
+    {
+      const MapStore::ReadAccess map = slam.ReadMap();
+      summary_.keyframes = map->NumKeyFrames();
+      summary_.landmarks = map->NumLandmarks();
+    }
     summary_.extraction = ComputeErrorStats(ext_);
     summary_.tracking = ComputeErrorStats(trk_);
     summary_.mapping = ComputeErrorStats(slam.mapping_times_ms());
@@ -185,35 +189,20 @@ struct LoadedFrame {
   double segmentation_ms = 0;
 };
 
-// The dynamic-object state carried across frames by the loading stage.
-struct SegmentationState {
-  explicit SegmentationState(const RunOptions& options)
-      : memory(options.slam.dynamic_memory_frames), every(std::max(1, options.segment_every)) {}
-  InstanceMemory memory;       // detections lost for a frame or two
-  MaskPropagator propagator;   // masks between segmented frames (segment_every > 1)
-  int every;
-};
-
 LoadedFrame LoadAndSegment(const RgbdDataset& dataset, const Settings& settings, size_t i,
-                           Segmenter* segmenter, SegmentationState* state) {
+                           SlamSystem* slam) {
   LoadedFrame f;
   f.index = static_cast<int64_t>(i);
   f.images = dataset.Load(i, settings.camera);
-  if (segmenter == nullptr) return f;
-  const auto t0 = std::chrono::steady_clock::now();
-  if (state->every > 1 && i % static_cast<size_t>(state->every) != 0) {
-    f.instances = state->propagator.Propagate(f.images.gray);
-  } else {
-    SegmenterInput in;
-    in.index = f.index;
-    in.stamp = dataset.frame(i).rgb_stamp;
-    in.bgr = f.images.bgr;
-    in.depth_m = f.images.depth_m;
-    f.instances = state->memory.Update(segmenter->Segment(in));
-    if (state->every > 1) state->propagator.Reset(f.images.gray, f.instances);
-  }
-  f.segmented = true;
-  f.segmentation_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  SegmenterInput in;
+  in.index = f.index;
+  in.stamp = dataset.frame(i).rgb_stamp;
+  in.bgr = f.images.bgr;
+  in.depth_m = f.images.depth_m;
+  FrameInstances dynamic = slam->SegmentFrame(in, f.images.gray);
+  f.instances = std::move(dynamic.instances);
+  f.segmented = dynamic.segmented;
+  f.segmentation_ms = dynamic.segmentation_ms;
   return f;
 }
 
@@ -223,35 +212,21 @@ Frame Extract(const SlamSystem& slam, const RgbdDataset& dataset, const LoadedFr
                            f.images.depth_m, cv::Mat(), report, f.segmented ? &f.instances : nullptr);
 }
 
-// Runs `body` in a thread that feeds `queue` and closes it at the end (or on error, keeping the
-// exception for the consumer).
-template <typename Fn>
-std::thread Producer(Fn body, std::exception_ptr* error, std::function<void()> close) {
-  return std::thread([body, error, close] {
-    try {
-      body();
-    } catch (...) {
-      *error = std::current_exception();
-    }
-    close();
-  });
-}
-
 }  // namespace
 
 RunSummary RunSequential(const RgbdDataset& dataset, const Settings& settings,
                          const RunOptions& options, const ProgressFn& progress,
                          Segmenter* segmenter) {
   const auto start = std::chrono::steady_clock::now();
-  SlamSystem slam(settings.camera, options.slam);
-  SegmentationState seg_state(options);
+  SlamSystem slam(settings.camera, options.slam, segmenter);
   const size_t n = FrameCount(dataset, options);
   RunRecorder recorder(n, progress);
   for (size_t i = 0; i < n; ++i) {
-    const LoadedFrame loaded = LoadAndSegment(dataset, settings, i, segmenter, &seg_state);
+    const LoadedFrame loaded = LoadAndSegment(dataset, settings, i, &slam);
     FrameReport report;
     Frame frame = Extract(slam, dataset, loaded, &report);
-    slam.TrackFrame(std::move(frame), &report);
+    const KeyFrameId kf = slam.TrackFrame(std::move(frame), &report);
+    if (kf != kNoKeyFrame) slam.MapKeyFrame(kf, &report);
     recorder.Add(report);
   }
   return recorder.Finish(dataset, settings, options, slam, start, segmenter);
@@ -261,8 +236,7 @@ RunSummary RunThreaded(const RgbdDataset& dataset, const Settings& settings,
                        const RunOptions& options, const ProgressFn& progress,
                        Segmenter* segmenter) {
   const auto start = std::chrono::steady_clock::now();
-  SlamSystem slam(settings.camera, options.slam);
-  SegmentationState seg_state(options);
+  SlamSystem slam(settings.camera, options.slam, segmenter);
   const size_t n = FrameCount(dataset, options);
   RunRecorder recorder(n, progress);
   struct Extracted {
@@ -271,39 +245,46 @@ RunSummary RunThreaded(const RgbdDataset& dataset, const Settings& settings,
   };
   BoundedQueue<LoadedFrame> loaded(options.queue_capacity);
   BoundedQueue<Extracted> extracted(options.queue_capacity);
-  std::exception_ptr load_error, extract_error;
-  std::thread loader = Producer(
-      [&] {
-        for (size_t i = 0; i < n; ++i) {
-          if (!loaded.Push(LoadAndSegment(dataset, settings, i, segmenter, &seg_state))) break;
-        }
-      },
-      &load_error, [&] { loaded.Close(); });
-  std::thread extractor = Producer(
-      [&] {
-        while (std::optional<LoadedFrame> f = loaded.Pop()) {
-          Extracted e;
-          e.frame = Extract(slam, dataset, *f, &e.report);
-          if (!extracted.Push(std::move(e))) break;
-        }
-      },
-      &extract_error, [&] { extracted.Close(); loaded.Close(); });
-  std::exception_ptr track_error;
-  try {
+  BoundedQueue<KeyFrameId> keyframes(8);
+  StageThreads stages([&] {
+    loaded.Close();
+    extracted.Close();
+    keyframes.Close();
+  });
+  stages.Start("loading", [&] {
+    for (size_t i = 0; i < n; ++i) {
+      if (!loaded.Push(LoadAndSegment(dataset, settings, i, &slam))) break;
+    }
+  }, [&] { loaded.Close(); });
+  stages.Start("extraction", [&] {
+    while (std::optional<LoadedFrame> f = loaded.Pop()) {
+      Extracted e;
+      e.frame = Extract(slam, dataset, *f, &e.report);
+      if (!extracted.Push(std::move(e))) break;
+    }
+  }, [&] { extracted.Close(); });
+  if (options.mapping_thread) {
+    stages.Start("local mapping", [&] {
+      while (std::optional<KeyFrameId> kf = keyframes.Pop()) {
+        FrameReport unused;
+        slam.MapKeyFrame(*kf, &unused);
+      }
+    });
+  }
+  stages.RunHere("tracking", [&] {
     while (std::optional<Extracted> e = extracted.Pop()) {
-      slam.TrackFrame(std::move(e->frame), &e->report);
+      const KeyFrameId kf = slam.TrackFrame(std::move(e->frame), &e->report);
+      if (kf != kNoKeyFrame) {
+        if (!options.mapping_thread) {
+          slam.MapKeyFrame(kf, &e->report);
+        } else if (!keyframes.Push(kf)) {
+          break;  // the mapping stage failed
+        }
+      }
       recorder.Add(e->report);
     }
-  } catch (...) {
-    track_error = std::current_exception();
-    extracted.Close();
-    loaded.Close();
-  }
-  loader.join();
-  extractor.join();
-  for (const std::exception_ptr& err : {track_error, load_error, extract_error}) {
-    if (err) std::rethrow_exception(err);
-  }
+  }, [&] { keyframes.Close(); });
+  stages.Join();
   return recorder.Finish(dataset, settings, options, slam, start, segmenter);
 }
 

@@ -18,9 +18,9 @@ namespace detslam {
 struct RunOptions {
   std::string out_dir = "out";  // where outputs go (created)
   int64_t max_frames = -1;      // stop after this many frames (< 0: all)
-  bool threaded = false;        // loading + extraction in a second thread (same results)
+  bool threaded = false;        // one thread per stage (see RunThreaded)
+  bool mapping_thread = false;  // threaded: local mapping in its own thread (not deterministic)
   size_t queue_capacity = 4;    // frames buffered between the threaded stages
-  int segment_every = 1;        // run the segmenter on every k-th frame; masks carried in between
   SlamOptions slam;
 };
 
@@ -51,10 +51,11 @@ RunSummary RunSequential(const RgbdDataset& dataset, const Settings& settings,
                          Segmenter* segmenter = nullptr);
 
 // Threaded mode: a loader/segmentation thread feeds an extraction thread, which feeds the
-// tracking thread, through bounded queues (closing a queue ends the stream). With
-// options.slam.mapping_thread, local mapping runs in a fourth thread (results then depend on
-// timing); without it, mapping runs in the tracking thread and the trajectory equals the
-// sequential one.
+// tracking thread (the calling one), through bounded queues (closing a queue ends the stream).
+// With options.mapping_thread, local mapping runs in a fourth thread fed by a keyframe queue
+// (results then depend on timing); without it, mapping runs in the tracking thread and the
+// trajectory equals the sequential one. An exception in any stage stops the others and is
+// rethrown here.
 RunSummary RunThreaded(const RgbdDataset& dataset, const Settings& settings,
                        const RunOptions& options, const ProgressFn& progress = nullptr,
                        Segmenter* segmenter = nullptr);

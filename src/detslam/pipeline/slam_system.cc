@@ -1,5 +1,6 @@
 #include "detslam/pipeline/slam_system.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <sstream>
@@ -31,110 +32,92 @@ ScaleInfo MakeScaleInfo(const OrbExtractor& extractor) {
   return s;
 }
 
-SlamSystem::SlamSystem(const PinholeCamera& camera, const SlamOptions& options)
+SlamSystem::SlamSystem(const PinholeCamera& camera, const SlamOptions& options,
+                       Segmenter* segmenter)
     : camera_(camera),
       options_(options),
       extractor_(options.orb),
-      map_(MakeScaleInfo(extractor_)),
-      tracker_(camera, options.tracker, &map_),
-      mapper_(camera, options.mapper, &map_),
-      loop_closer_(camera, options.loop, &map_) {
+      dynamic_(options.dynamic, segmenter),
+      store_(MakeScaleInfo(extractor_)),
+      tracker_(camera, options.tracker, options.dynamic.geometric),
+      mapper_(camera, options.mapper),
+      loop_closer_(camera, options.loop) {
   std::string error;
   DETSLAM_CHECK_MSG(camera_.Check(&error), error);
-  if (options_.mapping_thread) {
-    keyframe_queue_ = std::make_unique<BoundedQueue<KeyFrameId>>(8);
-    mapping_thread_ = std::thread([this] { MappingLoop(); });
-  }
-}
-
-SlamSystem::~SlamSystem() { Finish(); }
-
-void SlamSystem::Finish() {
-  if (!mapping_thread_.joinable()) return;
-  keyframe_queue_->Close();
-  mapping_thread_.join();
-}
-
-void SlamSystem::MappingLoop() {
-  while (std::optional<KeyFrameId> kf = keyframe_queue_->Pop()) {
-    FrameReport unused;
-    MapKeyFrame(*kf, &unused);
-  }
 }
 
 void SlamSystem::MapKeyFrame(KeyFrameId kf, FrameReport* report) {
   const auto t0 = std::chrono::steady_clock::now();
-  const LocalMappingSummary s = mapper_.ProcessKeyFrame(kf, options_.mapping_thread ? &map_mutex_ : nullptr);
-  std::unique_lock<std::mutex> lock;
-  if (options_.mapping_thread) lock = std::unique_lock<std::mutex>(map_mutex_);
+  const LocalMappingSummary s = mapper_.ProcessKeyFrame(kf, &store_);
+  const MapStore::WriteAccess map = store_.Write();
   for (const ErasedKeyFrame& e : s.erased_keyframes) {
     erased_[e.id] = e;
-    tracker_.OnKeyFrameErased(e.id);
+    tracker_.OnKeyFrameErased(*map, e.id);
   }
-  const LoopClosingResult loop = loop_closer_.Process(kf);
+  const LoopClosingResult loop = loop_closer_.Process(*map, kf);
   if (loop.closed) {
-    tracker_.OnLoopClosed(loop.old_poses);
+    tracker_.OnLoopClosed(*map, loop.old_poses);
     report->loop_closed = true;
   }
   report->timings.mapping_ms = MsSince(t0);
   mapping_times_ms_.push_back(report->timings.mapping_ms);
 }
 
+std::vector<double> SlamSystem::mapping_times_ms() const {
+  const MapStore::ReadAccess map = store_.Read();
+  return mapping_times_ms_;
+}
+
+int SlamSystem::loops_closed() const {
+  const MapStore::ReadAccess map = store_.Read();
+  return loop_closer_.loops_closed();
+}
+
 FrameReport SlamSystem::ProcessFrame(int64_t index, Timestamp stamp, const cv::Mat& gray,
                                      const cv::Mat& depth_m, const cv::Mat& ignore_mask) {
   FrameReport report;
   Frame frame = ExtractFrame(index, stamp, gray, depth_m, ignore_mask, &report);
-  TrackFrame(std::move(frame), &report);
+  const KeyFrameId kf = TrackFrame(std::move(frame), &report);
+  if (kf != kNoKeyFrame) MapKeyFrame(kf, &report);
   return report;
+}
+
+FrameInstances SlamSystem::SegmentFrame(const SegmenterInput& input, const cv::Mat& gray) {
+  return dynamic_.Segment(input, gray);
 }
 
 Frame SlamSystem::ExtractFrame(int64_t index, Timestamp stamp, const cv::Mat& gray,
                                const cv::Mat& depth_m, const cv::Mat& ignore_mask,
                                FrameReport* report, const std::vector<Instance>* instances) const {
   const auto t0 = std::chrono::steady_clock::now();
-  std::vector<cv::KeyPoint> keypoints;
-  cv::Mat descriptors;
-  cv::Mat mask = ignore_mask;
-  if (instances != nullptr && options_.dynamic_premask && !instances->empty()) {
-    cv::Mat dyn = DynamicIgnoreMask(*instances, depth_m, gray.size(), options_.dynamic);
-    if (mask.empty()) {
-      mask = dyn;
-    } else {
-      cv::bitwise_or(mask, dyn, mask);
-    }
-  }
-  extractor_.Extract(gray, mask, &keypoints, &descriptors);
-  std::vector<cv::KeyPoint> rejected;
+  LabelledKeypoints all = dynamic_.Extract(extractor_, gray, depth_m, ignore_mask, instances);
+  report->dynamic_instances = all.instances_used;
+  // Static keypoints go to tracking; the others stay in the frame for diagnostics only.
+  std::vector<cv::KeyPoint> kept, rejected;
+  std::vector<float> kept_depth;
   std::vector<KeypointLabel> rejected_labels;
-  if (instances != nullptr) {
-    std::vector<float> kp_depth(keypoints.size(), -1.0f);
-    for (size_t i = 0; i < keypoints.size() && !depth_m.empty(); ++i) {
-      const int u = static_cast<int>(std::lround(keypoints[i].pt.x));
-      const int v = static_cast<int>(std::lround(keypoints[i].pt.y));
-      if (u >= 0 && v >= 0 && u < depth_m.cols && v < depth_m.rows) kp_depth[i] = depth_m.at<float>(v, u);
-    }
-    std::vector<KeypointLabel> labels(keypoints.size(), KeypointLabel::kStatic);
-    const DynamicFilterStats stats = LabelDynamicKeypoints(keypoints, kp_depth, *instances, depth_m, options_.dynamic, &labels);
-    report->dynamic_instances = stats.instances_used;
-    std::vector<cv::KeyPoint> kept;
-    cv::Mat kept_desc;
-    for (size_t i = 0; i < keypoints.size(); ++i) {
-      if (labels[i] == KeypointLabel::kStatic) {
-        kept.push_back(keypoints[i]);
-        kept_desc.push_back(descriptors.row(static_cast<int>(i)));
+  cv::Mat kept_desc;
+  if (std::all_of(all.labels.begin(), all.labels.end(), [](KeypointLabel l) { return l == KeypointLabel::kStatic; })) {
+    kept = std::move(all.keypoints);
+    kept_depth = std::move(all.depth);
+    kept_desc = all.descriptors;
+  } else {
+    for (size_t i = 0; i < all.keypoints.size(); ++i) {
+      if (all.labels[i] == KeypointLabel::kStatic) {
+        kept.push_back(all.keypoints[i]);
+        kept_depth.push_back(all.depth[i]);
+        kept_desc.push_back(all.descriptors.row(static_cast<int>(i)));
       } else {
-        rejected.push_back(keypoints[i]);
-        rejected_labels.push_back(labels[i]);
+        rejected.push_back(all.keypoints[i]);
+        rejected_labels.push_back(all.labels[i]);
       }
     }
-    keypoints = std::move(kept);
-    descriptors = kept_desc;
-    report->rejected_keypoints = static_cast<int>(rejected.size());
   }
+  report->rejected_keypoints = static_cast<int>(rejected.size());
   Frame frame;
   frame.index = index;
   frame.stamp = stamp;
-  auto features = BuildFrameFeatures(camera_, std::move(keypoints), descriptors, depth_m);
+  auto features = BuildFrameFeatures(camera_, std::move(kept), kept_desc, std::move(kept_depth));
   features->rejected_keypoints = std::move(rejected);
   features->rejected_labels = std::move(rejected_labels);
   frame.features = std::move(features);
@@ -145,55 +128,50 @@ Frame SlamSystem::ExtractFrame(int64_t index, Timestamp stamp, const cv::Mat& gr
   return frame;
 }
 
-void SlamSystem::TrackFrame(Frame frame, FrameReport* report) {
+KeyFrameId SlamSystem::TrackFrame(Frame frame, FrameReport* report) {
   auto t0 = std::chrono::steady_clock::now();
-  std::unique_lock<std::mutex> lock;
-  if (options_.mapping_thread) lock = std::unique_lock<std::mutex>(map_mutex_);
-  const size_t kfs_before = map_.NumKeyFrames();
-  report->tracking = tracker_.Track(&frame);
+  const MapStore::WriteAccess access = store_.Write();
+  Map& map = *access;
+  const size_t kfs_before = map.NumKeyFrames();
+  report->tracking = tracker_.Track(map, &frame);
   KeyFrameId new_kf = kNoKeyFrame;
-  if (report->tracking.pose_valid && report->tracking.need_keyframe) new_kf = tracker_.CreateKeyFrame(&frame);
-  if (map_.NumKeyFrames() > kfs_before && new_kf == kNoKeyFrame) new_kf = tracker_.reference_keyframe();
+  if (report->tracking.pose_valid && report->tracking.need_keyframe) new_kf = tracker_.CreateKeyFrame(map, &frame);
+  if (map.NumKeyFrames() > kfs_before && new_kf == kNoKeyFrame) new_kf = tracker_.reference_keyframe();
   report->timings.tracking_ms = MsSince(t0);
 
   if (report->tracking.pose_valid) {
     const KeyFrameId ref = frame.reference_keyframe != kNoKeyFrame ? frame.reference_keyframe : tracker_.reference_keyframe();
-    tracked_.push_back({frame.stamp, ref, *frame.cam_from_world * map_.keyframe(ref).cam_from_world.Inverse()});
+    tracked_.push_back({frame.stamp, ref, *frame.cam_from_world * map.keyframe(ref).cam_from_world.Inverse()});
   }
-  if (new_kf != kNoKeyFrame) {
-    report->keyframe = true;
-    if (options_.mapping_thread) {
-      lock.unlock();
-      keyframe_queue_->Push(new_kf);
-    } else {
-      MapKeyFrame(new_kf, report);
-    }
-  }
+  report->keyframe = new_kf != kNoKeyFrame;
+  return new_kf;
 }
 
-Rigid3d SlamSystem::ReferenceWorldFromCam(KeyFrameId id, const Rigid3d& cam_from_ref) const {
+Rigid3d SlamSystem::ReferenceWorldFromCam(const Map& map, KeyFrameId id, const Rigid3d& cam_from_ref) const {
   // Walk up through erased keyframes to one that still exists.
   Rigid3d cam_from_kf = cam_from_ref;
   KeyFrameId kf = id;
-  for (int guard = 0; !map_.HasKeyFrame(kf) && guard < 100000; ++guard) {
+  for (int guard = 0; !map.HasKeyFrame(kf) && guard < 100000; ++guard) {
     auto it = erased_.find(kf);
     DETSLAM_CHECK_MSG(it != erased_.end(), "keyframe " << kf << " vanished without a record");
     cam_from_kf = cam_from_kf * it->second.cam_from_parent;
     kf = it->second.parent;
   }
-  return (cam_from_kf * map_.keyframe(kf).cam_from_world).Inverse();
+  return (cam_from_kf * map.keyframe(kf).cam_from_world).Inverse();
 }
 
 Trajectory SlamSystem::FrameTrajectory() const {
+  const MapStore::ReadAccess map = store_.Read();
   Trajectory out;
   out.reserve(tracked_.size());
-  for (const TrackedFrame& t : tracked_) out.push_back({t.stamp, ReferenceWorldFromCam(t.reference, t.cam_from_ref)});
+  for (const TrackedFrame& t : tracked_) out.push_back({t.stamp, ReferenceWorldFromCam(*map, t.reference, t.cam_from_ref)});
   return out;
 }
 
 Trajectory SlamSystem::KeyFrameTrajectory() const {
+  const MapStore::ReadAccess map = store_.Read();
   Trajectory out;
-  for (const auto& [id, kf] : map_.keyframes()) out.push_back({kf.stamp, kf.cam_from_world.Inverse()});
+  for (const auto& [id, kf] : map->keyframes()) out.push_back({kf.stamp, kf.cam_from_world.Inverse()});
   return out;
 }
 

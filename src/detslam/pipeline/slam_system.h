@@ -4,20 +4,17 @@
 #pragma once
 
 #include <map>
-#include <memory>
-#include <mutex>
-#include <thread>
 #include <opencv2/core.hpp>
 #include <string>
 #include <vector>
 
-#include "detslam/dynamic/dynamic_filter.h"
+#include "detslam/dynamic/detslam_stage.h"
 #include "detslam/features/orb_extractor.h"
 #include "detslam/io/trajectory.h"
 #include "detslam/loop/loop_closer.h"
 #include "detslam/map/map.h"
+#include "detslam/map/map_store.h"
 #include "detslam/mapping/local_mapper.h"
-#include "detslam/pipeline/bounded_queue.h"
 #include "detslam/tracking/tracker.h"
 
 namespace detslam {
@@ -27,10 +24,7 @@ struct SlamOptions {
   TrackerOptions tracker;
   LocalMapperOptions mapper;
   LoopClosingOptions loop;        // loop closing after local mapping of each keyframe
-  DynamicFilterOptions dynamic;   // Det-SLAM filter (used when instances are passed in)
-  bool dynamic_premask = true;    // also drop dynamic corners before the ORB spatial distribution
-  bool mapping_thread = false;    // local mapping in its own thread (not deterministic)
-  int dynamic_memory_frames = 3;  // carry lost dynamic instances forward this many frames (0.1 s)
+  DetSlamOptions dynamic;         // the Det-SLAM stage (segmentation, filter, geometric check)
   bool Check(std::string* error) const;
 };
 
@@ -47,58 +41,70 @@ struct FrameReport {
   Timestamp stamp;
   TrackingResult tracking;
   bool keyframe = false;
-  bool loop_closed = false;   // this frame's keyframe closed a loop (sequential/inline mapping)
+  bool loop_closed = false;   // this frame's keyframe closed a loop (mapping in the tracking thread)
   int num_keypoints = 0;
   FrameTimings timings;
 };
 
+// The SLAM stages of one sequence. It starts no thread: the runner calls ExtractFrame,
+// TrackFrame and MapKeyFrame from whichever threads it runs them in (pipeline/runner.cc).
+// ExtractFrame is const and may run ahead; TrackFrame must see the frames in input order and
+// MapKeyFrame the keyframes in the order TrackFrame made them. TrackFrame and MapKeyFrame may run
+// concurrently: the map store's lock guards the map, the tracker's state and the trajectory
+// bookkeeping.
 class SlamSystem {
  public:
-  SlamSystem(const PinholeCamera& camera, const SlamOptions& options);
-  ~SlamSystem();
+  // `segmenter` (may be null: no dynamic-object filtering) feeds the Det-SLAM stage.
+  SlamSystem(const PinholeCamera& camera, const SlamOptions& options,
+             Segmenter* segmenter = nullptr);
   SlamSystem(const SlamSystem&) = delete;
   SlamSystem& operator=(const SlamSystem&) = delete;
 
-  // Waits until the mapping thread (if any) has processed every queued keyframe and stops it.
-  // Call before reading the trajectory or the map; ProcessFrame/TrackFrame must not follow.
-  void Finish();
-
-  // Processes one RGB-D frame: ExtractFrame then TrackFrame. gray: CV_8UC1; depth_m: CV_32FC1
-  // metres (0 = missing); ignore_mask: empty or CV_8UC1, non-zero = no keypoints there.
+  // Processes one RGB-D frame in the calling thread: ExtractFrame, TrackFrame and, for a new
+  // keyframe, MapKeyFrame. gray: CV_8UC1; depth_m: CV_32FC1 metres (0 = missing); ignore_mask:
+  // empty or CV_8UC1, non-zero = no keypoints there.
   FrameReport ProcessFrame(int64_t index, Timestamp stamp, const cv::Mat& gray,
                            const cv::Mat& depth_m, const cv::Mat& ignore_mask = cv::Mat());
 
+  // Loading stage (frames in input order): the frame's dynamic instances from the Det-SLAM stage
+  // (segmenter, instance memory, mask propagation). Not segmented without a segmenter.
+  FrameInstances SegmentFrame(const SegmenterInput& input, const cv::Mat& gray);
   // Feature extraction stage: thread-safe (const), may run ahead of tracking in another thread.
-  // With `instances` (from a segmenter), the Det-SLAM filter rejects keypoints on dynamic objects:
+  // With `instances` (from SegmentFrame), the Det-SLAM stage labels keypoints on dynamic objects:
   // they are moved to the frame's rejected list (labelled) and never reach tracking. Fills
   // report->timings.extraction_ms, num_keypoints and the dynamic counters.
   Frame ExtractFrame(int64_t index, Timestamp stamp, const cv::Mat& gray, const cv::Mat& depth_m,
                      const cv::Mat& ignore_mask, FrameReport* report,
                      const std::vector<Instance>* instances = nullptr) const;
-  // Tracking and (for keyframes) local mapping of an extracted frame, in input order.
-  void TrackFrame(Frame frame, FrameReport* report);
+  // Tracking stage: tracks an extracted frame (input order) and makes it a keyframe when the
+  // tracker asks for one. Returns the new keyframe for MapKeyFrame, or kNoKeyFrame.
+  KeyFrameId TrackFrame(Frame frame, FrameReport* report);
+  // Local mapping stage: local mapping and loop closing of a keyframe from TrackFrame. Fills
+  // report->timings.mapping_ms and loop_closed.
+  void MapKeyFrame(KeyFrameId kf, FrameReport* report);
 
   // Every tracked frame's pose, recomputed from its reference keyframe's current pose.
   Trajectory FrameTrajectory() const;
   // Keyframe poses (world_from_cam) in id order.
   Trajectory KeyFrameTrajectory() const;
-  const Map& map() const { return map_; }
+  // Read access to the map (holds the lock while it lives).
+  MapStore::ReadAccess ReadMap() const { return store_.Read(); }
   // Local-mapping time of every processed keyframe (ms), in processing order.
-  const std::vector<double>& mapping_times_ms() const { return mapping_times_ms_; }
+  std::vector<double> mapping_times_ms() const;
   // Loops closed so far.
-  int loops_closed() const { return loop_closer_.loops_closed(); }
+  int loops_closed() const;
 
  private:
-  Rigid3d ReferenceWorldFromCam(KeyFrameId id, const Rigid3d& cam_from_ref) const;
-  void MapKeyFrame(KeyFrameId kf, FrameReport* report);
-  void MappingLoop();
+  Rigid3d ReferenceWorldFromCam(const Map& map, KeyFrameId id, const Rigid3d& cam_from_ref) const;
 
   PinholeCamera camera_;
   SlamOptions options_;
   OrbExtractor extractor_;
-  Map map_;
+  DetSlamStage dynamic_;
+  MapStore store_;  // the map's one owner; its lock also guards everything below
   Tracker tracker_;
   LocalMapper mapper_;
+  LoopCloser loop_closer_;
   struct TrackedFrame {
     Timestamp stamp;
     KeyFrameId reference;
@@ -107,12 +113,6 @@ class SlamSystem {
   std::vector<TrackedFrame> tracked_;
   std::map<KeyFrameId, ErasedKeyFrame> erased_;
   std::vector<double> mapping_times_ms_;
-  LoopCloser loop_closer_;
-  // Mapping thread: the map store's one lock guards map_, tracker_ state and erased_ while both
-  // threads run; the queue hands keyframes from tracking to mapping.
-  std::mutex map_mutex_;
-  std::unique_ptr<BoundedQueue<KeyFrameId>> keyframe_queue_;
-  std::thread mapping_thread_;
 };
 
 ScaleInfo MakeScaleInfo(const OrbExtractor& extractor);

@@ -11,8 +11,20 @@
 #include "detslam/features/matcher.h"
 #include "detslam/geometry/pnp_ransac.h"
 #include "detslam/map/projection_search.h"
+#include "detslam/tracking/keypoint_observation.h"
 
 namespace detslam {
+
+void Tracker::FrameScratch::Reset(size_t n) {
+  temp_matched.assign(n, false);
+  temp_match_position.assign(n, Eigen::Vector3d::Zero());
+  dropped.assign(n, false);
+  dropped_position.assign(n, Eigen::Vector3d::Zero());
+}
+
+void Tracker::FrameScratch::ClearTemporaryMatches() {
+  temp_matched.assign(temp_matched.size(), false);
+}
 
 const char* ToString(TrackingState state) {
   switch (state) {
@@ -35,40 +47,38 @@ bool TrackerOptions::Check(std::string* error) const {
   return os.str().empty();
 }
 
-Tracker::Tracker(const PinholeCamera& camera, TrackerOptions options, Map* map)
-    : camera_(camera), options_(options), map_(map), rng_(options.seed) {
+Tracker::Tracker(const PinholeCamera& camera, TrackerOptions options, MoverCheckOptions movers)
+    : camera_(camera), options_(options), movers_(movers), rng_(options.seed) {
   std::string error;
   DETSLAM_CHECK_MSG(options_.Check(&error), error);
+  DETSLAM_CHECK_MSG(movers_.Check(&error), error);
 }
 
-void Tracker::OnKeyFrameErased(KeyFrameId id) {
-  if (reference_kf_ == id || !map_->HasKeyFrame(reference_kf_)) {
-    reference_kf_ = map_->NumKeyFrames() ? map_->keyframes().rbegin()->first : kNoKeyFrame;
+void Tracker::OnKeyFrameErased(const Map& map, KeyFrameId id) {
+  if (reference_kf_ == id || !map.HasKeyFrame(reference_kf_)) {
+    reference_kf_ = map.NumKeyFrames() ? map.keyframes().rbegin()->first : kNoKeyFrame;
   }
   if (last_keyframe_ == id) last_keyframe_ = reference_kf_;
 }
 
-void Tracker::OnLoopClosed(const std::map<KeyFrameId, Rigid3d>& old_poses) {
+void Tracker::OnLoopClosed(const Map& map, const std::map<KeyFrameId, Rigid3d>& old_poses) {
   if (!last_frame_ || !last_frame_->cam_from_world) return;
   KeyFrameId ref = last_frame_->reference_keyframe;
-  if (!map_->HasKeyFrame(ref) || !old_poses.count(ref)) ref = reference_kf_;
-  if (!map_->HasKeyFrame(ref) || !old_poses.count(ref)) return;
-  last_frame_->cam_from_world = *last_frame_->cam_from_world * old_poses.at(ref).Inverse() * map_->keyframe(ref).cam_from_world;
-  BuildTemporaryPoints();
+  if (!map.HasKeyFrame(ref) || !old_poses.count(ref)) ref = reference_kf_;
+  if (!map.HasKeyFrame(ref) || !old_poses.count(ref)) return;
+  last_frame_->cam_from_world = *last_frame_->cam_from_world * old_poses.at(ref).Inverse() * map.keyframe(ref).cam_from_world;
+  BuildTemporaryPoints(map);
 }
 
-TrackingResult Tracker::Track(Frame* frame) {
+TrackingResult Tracker::Track(Map& map, Frame* frame) {
   TrackingResult result;
   frame->landmarks.assign(frame->size(), kNoLandmark);
   frame->outlier.assign(frame->size(), false);
   frame->labels.assign(frame->size(), KeypointLabel::kStatic);
-  temp_matched_.assign(frame->size(), false);
-  temp_match_position_.assign(frame->size(), Eigen::Vector3d::Zero());
-  dropped_.assign(frame->size(), false);
-  dropped_position_.assign(frame->size(), Eigen::Vector3d::Zero());
+  scratch_.Reset(frame->size());
 
   if (state_ == TrackingState::kNotInitialized) {
-    if (Initialize(frame)) {
+    if (Initialize(map, frame)) {
       state_ = TrackingState::kOk;
       result.pose_valid = true;
       result.method = "init";
@@ -76,31 +86,31 @@ TrackingResult Tracker::Track(Frame* frame) {
       result.method = "waiting for a frame with enough depth";
     }
     result.state = state_;
-    if (result.pose_valid) last_frame_ = *frame, BuildTemporaryPoints();
+    if (result.pose_valid) last_frame_ = *frame, BuildTemporaryPoints(map);
     return result;
   }
 
   bool ok = false;
   if (state_ == TrackingState::kOk) {
     if (velocity_ && frame->index >= last_reloc_frame_ + 2) {
-      ok = TrackWithMotionModel(frame);
+      ok = TrackWithMotionModel(map, frame);
       result.method = "motion";
     }
     if (!ok) {
-      ok = TrackReferenceKeyFrame(frame);
+      ok = TrackReferenceKeyFrame(map, frame);
       result.method = "reference";
     }
   } else {
-    ok = Relocalize(frame);
+    ok = Relocalize(map, frame);
     result.method = "relocalization";
     result.relocalized = ok;
     if (ok) last_reloc_frame_ = frame->index;
   }
   int inliers = 0;
-  if (ok) ok = TrackLocalMap(frame, &inliers);
+  if (ok) ok = TrackLocalMap(map, frame, &inliers);
   if (!ok && state_ == TrackingState::kOk) {
     // Last resort before declaring the frame lost: global relocalisation right away.
-    ok = Relocalize(frame) && TrackLocalMap(frame, &inliers);
+    ok = Relocalize(map, frame) && TrackLocalMap(map, frame, &inliers);
     if (ok) {
       result.method = "relocalization";
       result.relocalized = true;
@@ -108,18 +118,18 @@ TrackingResult Tracker::Track(Frame* frame) {
     }
   }
 
-  if (ok && options_.geometric_check) result.geometric_rejected = ApplyGeometricCheck(frame, &inliers);
+  if (ok && movers_.enabled) result.geometric_rejected = ApplyGeometricCheck(map, frame, &inliers);
   if (ok) {
     state_ = TrackingState::kOk;
     result.pose_valid = true;
     result.num_inliers = inliers;
-    result.need_keyframe = NeedNewKeyFrame(*frame, inliers);
+    result.need_keyframe = NeedNewKeyFrame(map, *frame, inliers);
     if (last_frame_ && last_frame_->cam_from_world) {
       velocity_ = *frame->cam_from_world * last_frame_->cam_from_world->Inverse();
     }
     frame->reference_keyframe = reference_kf_;
     last_frame_ = *frame;
-    BuildTemporaryPoints();
+    BuildTemporaryPoints(map);
   } else {
     if (state_ == TrackingState::kOk) {
       state_ = TrackingState::kRecentlyLost;
@@ -137,18 +147,18 @@ TrackingResult Tracker::Track(Frame* frame) {
   return result;
 }
 
-bool Tracker::Initialize(Frame* frame) {
+bool Tracker::Initialize(Map& map, Frame* frame) {
   const FrameFeatures& f = *frame->features;
   int with_depth = 0;
   for (size_t i = 0; i < f.size(); ++i) with_depth += f.depth[i] > 0 ? 1 : 0;
   if (with_depth < options_.min_init_keypoints) return false;
   frame->cam_from_world = Rigid3d::Identity();
-  CreateKeyFrame(frame);
-  spdlog::info("map initialised with {} landmarks", map_->NumLandmarks());
+  CreateKeyFrame(map, frame);
+  spdlog::info("map initialised with {} landmarks", map.NumLandmarks());
   return true;
 }
 
-void Tracker::BuildTemporaryPoints() {
+void Tracker::BuildTemporaryPoints(const Map& map) {
   // ORB-SLAM's UpdateLastFrame for RGB-D: points from the last frame's depth for keypoints
   // without a landmark, closest first, all closer than ThDepth and at least 100.
   temporary_points_.assign(last_frame_->size(), std::nullopt);
@@ -162,7 +172,7 @@ void Tracker::BuildTemporaryPoints() {
   int created = 0;
   for (const auto& [d, i] : by_depth) {
     if (!last_frame_->labels.empty() && last_frame_->labels[i] != KeypointLabel::kStatic) continue;
-    const bool has_landmark = last_frame_->landmarks[i] != kNoLandmark && map_->HasLandmark(last_frame_->landmarks[i]);
+    const bool has_landmark = last_frame_->landmarks[i] != kNoLandmark && map.HasLandmark(last_frame_->landmarks[i]);
     if (!has_landmark) {
       temporary_points_[i] = world_from_cam * camera_.Unproject(f.undist[i], d);
       ++created;
@@ -171,7 +181,7 @@ void Tracker::BuildTemporaryPoints() {
   }
 }
 
-bool Tracker::TrackWithMotionModel(Frame* frame) {
+bool Tracker::TrackWithMotionModel(const Map& map, Frame* frame) {
   frame->cam_from_world = *velocity_ * *last_frame_->cam_from_world;
   const FrameFeatures& last = *last_frame_->features;
   std::vector<ProjectionCandidate> candidates;
@@ -179,9 +189,9 @@ bool Tracker::TrackWithMotionModel(Frame* frame) {
   for (size_t i = 0; i < last.size(); ++i) {
     ProjectionCandidate c;
     const LandmarkId id = last_frame_->landmarks[i];
-    if (id != kNoLandmark && !last_frame_->outlier[i] && map_->HasLandmark(id)) {
+    if (id != kNoLandmark && !last_frame_->outlier[i] && map.HasLandmark(id)) {
       c.landmark = id;
-      c.position = map_->landmark(id).position;
+      c.position = map.landmark(id).position;
     } else if (temporary_points_[i]) {
       c.position = *temporary_points_[i];
     } else {
@@ -195,67 +205,62 @@ bool Tracker::TrackWithMotionModel(Frame* frame) {
   }
   ProjectionSearchOptions opt;
   opt.window = options_.motion_window;
-  opt.ratio = 0.9;
+  opt.ratio = kMotionRatio;
   opt.max_distance = kThHigh;
   opt.check_orientation = true;
   auto apply = [&](const std::vector<int>& matches) {
     int n = 0;
     frame->landmarks.assign(frame->size(), kNoLandmark);
-    temp_matched_.assign(frame->size(), false);
+    scratch_.ClearTemporaryMatches();
     for (size_t c = 0; c < candidates.size(); ++c) {
       if (matches[c] < 0) continue;
       const size_t kp = static_cast<size_t>(matches[c]);
       if (candidates[c].landmark != kNoLandmark) {
         frame->landmarks[kp] = candidates[c].landmark;
       } else {
-        temp_matched_[kp] = true;
-        temp_match_position_[kp] = candidates[c].position;
+        scratch_.temp_matched[kp] = true;
+        scratch_.temp_match_position[kp] = candidates[c].position;
       }
       ++n;
     }
     return n;
   };
-  int n = apply(SearchByProjection(camera_, map_->scale(), *frame->features, *frame->cam_from_world,
+  int n = apply(SearchByProjection(camera_, map.scale(), *frame->features, *frame->cam_from_world,
                                    candidates, {}, opt));
   if (n < options_.min_motion_matches) {
     opt.window *= 2;
-    n = apply(SearchByProjection(camera_, map_->scale(), *frame->features, *frame->cam_from_world,
+    n = apply(SearchByProjection(camera_, map.scale(), *frame->features, *frame->cam_from_world,
                                  candidates, {}, opt));
   }
   if (n < options_.min_motion_matches) return false;
-  return OptimizeFramePose(frame, true) >= options_.min_pose_inliers;
+  return OptimizeFramePose(map, frame, true) >= options_.min_pose_inliers;
 }
 
-bool Tracker::TrackReferenceKeyFrame(Frame* frame) {
-  if (!map_->HasKeyFrame(reference_kf_)) return false;
-  const KeyFrame& ref = map_->keyframe(reference_kf_);
-  frame->landmarks = MatchKeyFrameLandmarks(ref, *frame->features, 0.7, kThLow);
+bool Tracker::TrackReferenceKeyFrame(const Map& map, Frame* frame) {
+  if (!map.HasKeyFrame(reference_kf_)) return false;
+  const KeyFrame& ref = map.keyframe(reference_kf_);
+  frame->landmarks = MatchKeyFrameLandmarks(ref, *frame->features, kReferenceRatio, kThLow);
   const auto matched = std::count_if(frame->landmarks.begin(), frame->landmarks.end(),
                                      [](LandmarkId id) { return id != kNoLandmark; });
-  if (matched < 15) return false;
+  if (matched < kMinReferenceMatches) return false;
   frame->cam_from_world = last_frame_ ? *last_frame_->cam_from_world : ref.cam_from_world;
-  return OptimizeFramePose(frame, false) >= options_.min_pose_inliers;
+  return OptimizeFramePose(map, frame, false) >= options_.min_pose_inliers;
 }
 
-int Tracker::OptimizeFramePose(Frame* frame, bool include_temporary) {
+int Tracker::OptimizeFramePose(const Map& map, Frame* frame, bool include_temporary) {
   const FrameFeatures& f = *frame->features;
   std::vector<PoseObservation> obs;
   std::vector<size_t> kp_of_obs;
   for (size_t i = 0; i < f.size(); ++i) {
     Eigen::Vector3d p;
     if (frame->landmarks[i] != kNoLandmark) {
-      p = map_->landmark(frame->landmarks[i]).position;
-    } else if (include_temporary && temp_matched_[i]) {
-      p = temp_match_position_[i];
+      p = map.landmark(frame->landmarks[i]).position;
+    } else if (include_temporary && scratch_.temp_matched[i]) {
+      p = scratch_.temp_match_position[i];
     } else {
       continue;
     }
-    PoseObservation o;
-    o.point_world = p;
-    o.uv = f.undist[i];
-    o.u_right = f.u_right[i];
-    o.inv_sigma2 = map_->scale().inv_level_sigma2[static_cast<size_t>(f.keypoints[i].octave)];
-    obs.push_back(o);
+    obs.push_back(KeypointObservation(f, i, p, map.scale()));
     kp_of_obs.push_back(i);
   }
   if (obs.size() < 3) return 0;
@@ -268,10 +273,10 @@ int Tracker::OptimizeFramePose(Frame* frame, bool include_temporary) {
     if (r.inliers[k]) {
       ++inliers;
     } else {
-      dropped_[i] = true;
-      dropped_position_[i] = obs[k].point_world;
+      scratch_.dropped[i] = true;
+      scratch_.dropped_position[i] = obs[k].point_world;
       frame->landmarks[i] = kNoLandmark;
-      temp_matched_[i] = false;
+      scratch_.temp_matched[i] = false;
       frame->outlier[i] = true;
     }
   }

@@ -36,15 +36,6 @@ struct TrackerOptions {
   int close_tracked_max = 100;         // bNeedToInsertClose: tracked close < this
   int close_untracked_min = 70;        //                      and untracked close > this
   uint64_t seed = 42;                  // relocalisation RANSAC
-  // Geometric check for movers the segmenter missed (see tracker_geometric.cc). On by default: it
-  // lowered the error on the walking presets where the detector misses partly visible people and
-  // changed nothing on the static benchmarks (docs/BENCHMARKS.md).
-  bool geometric_check = true;
-  GeometricCheckOptions geometric;     // robust threshold on reprojection residuals (pixels / scale)
-  double geometric_radius_px = 30.0;   // cluster / spread radius around a flagged keypoint
-  double geometric_depth_ratio = 0.1;  // same object: depths within this fraction
-  int geometric_min_cluster = 3;       // flagged neighbours needed to confirm a mover
-  double geometric_carry_window = 15.0;  // search window for last frame's movers (pixels, level 0)
   bool Check(std::string* error) const;
 };
 
@@ -58,50 +49,84 @@ struct TrackingResult {
   std::string method;            // "init", "motion", "reference", "relocalization", "lost"
 };
 
+// The tracker borrows the map for each call: its callers hold the map store's write access (which
+// also guards the tracker's own state, since the mapping thread calls OnKeyFrameErased and
+// OnLoopClosed) and pass the map in.
 class Tracker {
  public:
-  Tracker(const PinholeCamera& camera, TrackerOptions options, Map* map);
+  // `movers`: the Det-SLAM stage's geometric check for movers the segmenter missed, run after
+  // the pose is tracked (its options live in DetSlamOptions).
+  Tracker(const PinholeCamera& camera, TrackerOptions options, MoverCheckOptions movers = {});
 
   // Tracks `frame` (its features must be set). Fills frame->cam_from_world, landmarks, outliers,
   // reference_keyframe. Creates the first keyframe on initialisation.
-  TrackingResult Track(Frame* frame);
+  TrackingResult Track(Map& map, Frame* frame);
 
   // Turns the current frame into a keyframe: links its inlier landmarks, creates landmarks from
   // close depth (ORB-SLAM's CreateNewKeyFrame for RGB-D). Returns its id.
-  KeyFrameId CreateKeyFrame(Frame* frame);
+  KeyFrameId CreateKeyFrame(Map& map, Frame* frame);
 
   TrackingState state() const { return state_; }
   // Reference keyframe of the last tracked frame.
   KeyFrameId reference_keyframe() const { return reference_kf_; }
   // Called by the mapper when a keyframe has been erased, so the tracker drops references.
-  void OnKeyFrameErased(KeyFrameId id);
+  void OnKeyFrameErased(const Map& map, KeyFrameId id);
   // Called after loop closing moved the keyframes (`old_poses`: their poses before): moves the
   // last frame with its reference keyframe.
-  void OnLoopClosed(const std::map<KeyFrameId, Rigid3d>& old_poses);
+  void OnLoopClosed(const Map& map, const std::map<KeyFrameId, Rigid3d>& old_poses);
 
  private:
-  bool Initialize(Frame* frame);
-  bool TrackWithMotionModel(Frame* frame);
-  bool TrackReferenceKeyFrame(Frame* frame);
-  bool TrackLocalMap(Frame* frame, int* inliers);
-  bool Relocalize(Frame* frame);
-  bool NeedNewKeyFrame(const Frame& frame, int inliers) const;
+  // ORB-SLAM3's fixed tracking thresholds (Tracking.cc, RGB-D), named.
+  static constexpr size_t kLocalMapCovisibles = 10;    // UpdateLocalKeyFrames: best covisibles per K1 keyframe
+  static constexpr int kMinReferenceMatches = 15;      // TrackReferenceKeyFrame: BoW matches needed
+  static constexpr double kReferenceRatio = 0.7;       //   and its matcher's nearest-neighbour ratio
+  static constexpr double kMotionRatio = 0.9;          // TrackWithMotionModel's matcher ratio
+  static constexpr double kLocalMapRatio = 0.8;        // SearchLocalPoints' matcher ratio
+  static constexpr double kRelocLocalMapWindow = 5.0;  // SearchLocalPoints' window right after relocalisation
+  static constexpr size_t kMinRelocalizationMatches = 15; // Relocalization: candidate keyframe matches
+  static constexpr double kRelocalizationRatio = 0.75; //   and its matcher's ratio
+  static constexpr int kMinRelocalizationPnpInliers = 10;  // PnP + pose optimisation inliers to go on
+  static constexpr int kRelocalizationInliers = 50;    // inliers that accept a relocalisation; also
+                                                       // TrackLocalMap's need right after one
+  static constexpr double kRelocalizationWindow = 10;  // projection search widening a relocalisation
+  static constexpr double kRelocalizationProjectionRatio = 0.9;
+  static constexpr int kMinKeyFrameInliers = 15;       // NeedNewKeyFrame c2: at least this many inliers
+  static constexpr double kNewKeyFrameRefRatioOneKf = 0.4;  // thRefRatio with one keyframe
+  static constexpr double kNewKeyFrameLowRatio = 0.25;      // c1c: weak tracking against the reference
+
+  // Per-keypoint state of the frame being tracked, reset once at the start of Track.
+  struct FrameScratch {
+    std::vector<bool> temp_matched;  // matched to a frame-to-frame (temporary) point
+    std::vector<Eigen::Vector3d> temp_match_position;
+    // The point of an association the pose optimiser rejected (for the geometric check).
+    std::vector<bool> dropped;
+    std::vector<Eigen::Vector3d> dropped_position;
+    void Reset(size_t n);
+    void ClearTemporaryMatches();  // track without frame-to-frame points from here on
+  };
+
+  bool Initialize(Map& map, Frame* frame);
+  bool TrackWithMotionModel(const Map& map, Frame* frame);
+  bool TrackReferenceKeyFrame(const Map& map, Frame* frame);
+  bool TrackLocalMap(Map& map, Frame* frame, int* inliers);
+  bool Relocalize(const Map& map, Frame* frame);
+  bool NeedNewKeyFrame(const Map& map, const Frame& frame, int inliers) const;
   // Pose optimisation over the frame's matched landmarks and temporary points; marks outliers and
   // drops their associations. Returns the number of inliers.
-  int OptimizeFramePose(Frame* frame, bool include_temporary);
-  void BuildTemporaryPoints();
+  int OptimizeFramePose(const Map& map, Frame* frame, bool include_temporary);
+  void BuildTemporaryPoints(const Map& map);
   // Labels movers the segmenter missed as kGeometric (after the final pose is known): matched
   // keypoints whose residual is far above the static ones' and confirmed by flagged neighbours,
   // unmatched keypoints next to them at the same depth, and keypoints matching the last frame's
   // movers. Drops their landmark associations and re-optimises the pose if any was an inlier.
   // Returns the number of labelled keypoints.
-  int ApplyGeometricCheck(Frame* frame, int* inliers);
-  void UpdateLocalMap(const Frame& frame);
-  KeyFrameId CreateLandmarksFromDepth(Frame* frame, KeyFrameId kf_id);
+  int ApplyGeometricCheck(const Map& map, Frame* frame, int* inliers);
+  void UpdateLocalMap(const Map& map, const Frame& frame);
+  KeyFrameId CreateLandmarksFromDepth(Map& map, Frame* frame, KeyFrameId kf_id);
 
   PinholeCamera camera_;
   TrackerOptions options_;
-  Map* map_;
+  MoverCheckOptions movers_;
   Rng rng_;
   PoseOptimizerOptions pose_options_;
   TrackingState state_ = TrackingState::kNotInitialized;
@@ -116,12 +141,7 @@ class Tracker {
   Timestamp lost_since_;
   std::vector<KeyFrameId> local_keyframes_;
   std::vector<LandmarkId> local_landmarks_;
-  std::vector<bool> temp_matched_;  // per current keypoint: matched to a temporary point
-  std::vector<Eigen::Vector3d> temp_match_position_;
-  // Per current keypoint: the point of an association the pose optimiser rejected (for the
-  // geometric check's residuals).
-  std::vector<bool> dropped_;
-  std::vector<Eigen::Vector3d> dropped_position_;
+  FrameScratch scratch_;
 };
 
 }  // namespace detslam

@@ -28,20 +28,20 @@ bool SameDepth(float a, float b, double ratio) {
 
 }  // namespace
 
-int Tracker::ApplyGeometricCheck(Frame* frame, int* inliers) {
+int Tracker::ApplyGeometricCheck(const Map& map, Frame* frame, int* inliers) {
   const FrameFeatures& f = *frame->features;
   const size_t n = f.size();
   const Rigid3d& pose = *frame->cam_from_world;
-  const ScaleInfo& scale = map_->scale();
+  const ScaleInfo& scale = map.scale();
 
   // 1. Residuals of every associated keypoint at the optimised pose.
   std::vector<double> residual(n, -1.0);
   for (size_t i = 0; i < n; ++i) {
     Eigen::Vector3d p;
-    if (frame->landmarks[i] != kNoLandmark && map_->HasLandmark(frame->landmarks[i])) {
-      p = map_->landmark(frame->landmarks[i]).position;
-    } else if (dropped_[i]) {
-      p = dropped_position_[i];
+    if (frame->landmarks[i] != kNoLandmark && map.HasLandmark(frame->landmarks[i])) {
+      p = map.landmark(frame->landmarks[i]).position;
+    } else if (scratch_.dropped[i]) {
+      p = scratch_.dropped_position[i];
     } else {
       continue;
     }
@@ -51,21 +51,21 @@ int Tracker::ApplyGeometricCheck(Frame* frame, int* inliers) {
     residual[i] = (uv - f.undist[i]).norm() / scale.scale_factors[static_cast<size_t>(f.keypoints[i].octave)];
   }
   std::vector<KeypointLabel> candidate = frame->labels;
-  const GeometricCheckResult stats = FlagGeometricOutliers(residual, options_.geometric, &candidate);
+  const GeometricCheckResult stats = FlagGeometricOutliers(residual, movers_.threshold, &candidate);
 
   // 2. Confirm candidates by flagged neighbours at the same depth.
-  const double radius = options_.geometric_radius_px;
+  const double radius = movers_.radius_px;
   std::vector<size_t> seeds;
   for (size_t i = 0; i < n; ++i) {
     if (candidate[i] != KeypointLabel::kGeometric) continue;
     int neighbours = 0;
     for (size_t j : f.grid->FeaturesInArea(f.undist[i].x(), f.undist[i].y(), radius)) {
       if (j != i && candidate[j] == KeypointLabel::kGeometric &&
-          SameDepth(f.depth[i], f.depth[j], options_.geometric_depth_ratio)) {
+          SameDepth(f.depth[i], f.depth[j], movers_.depth_ratio)) {
         ++neighbours;
       }
     }
-    if (neighbours >= options_.geometric_min_cluster) seeds.push_back(i);
+    if (neighbours >= movers_.min_cluster) seeds.push_back(i);
   }
 
   // 3. Keypoints matching the last frame's movers (searched around their last 3-D position) that
@@ -86,7 +86,7 @@ int Tracker::ApplyGeometricCheck(Frame* frame, int* inliers) {
     }
     if (!movers.empty()) {
       ProjectionSearchOptions opt;
-      opt.window = options_.geometric_carry_window;
+      opt.window = movers_.carry_window_px;
       opt.ratio = 0.9;
       opt.max_distance = kThHigh;
       const std::vector<int> m = SearchByProjection(camera_, scale, f, pose, movers, TakenMask(*frame), opt);
@@ -112,7 +112,7 @@ int Tracker::ApplyGeometricCheck(Frame* frame, int* inliers) {
   for (size_t i : seeds) {
     label(i);
     for (size_t j : f.grid->FeaturesInArea(f.undist[i].x(), f.undist[i].y(), radius)) {
-      if (frame->landmarks[j] == kNoLandmark && SameDepth(f.depth[i], f.depth[j], options_.geometric_depth_ratio)) {
+      if (frame->landmarks[j] == kNoLandmark && SameDepth(f.depth[i], f.depth[j], movers_.depth_ratio)) {
         label(j);
       }
     }
@@ -131,8 +131,8 @@ int Tracker::ApplyGeometricCheck(Frame* frame, int* inliers) {
     }
   }
   if (dropped_inlier) {
-    temp_matched_.assign(n, false);
-    *inliers = OptimizeFramePose(frame, false);
+    scratch_.temp_matched.assign(n, false);
+    *inliers = OptimizeFramePose(map, frame, false);
   }
   return labelled;
 }

@@ -12,13 +12,13 @@
 
 namespace detslam {
 
-void Tracker::UpdateLocalMap(const Frame& frame) {
+void Tracker::UpdateLocalMap(const Map& map, const Frame& frame) {
   // K1: keyframes that observe the frame's landmarks, with the count of shared landmarks.
   std::map<KeyFrameId, int> counts;
   for (size_t i = 0; i < frame.size(); ++i) {
     const LandmarkId id = frame.landmarks[i];
-    if (id == kNoLandmark || !map_->HasLandmark(id)) continue;
-    for (const auto& [kf, idx] : map_->landmark(id).observations) {
+    if (id == kNoLandmark || !map.HasLandmark(id)) continue;
+    for (const auto& [kf, idx] : map.landmark(id).observations) {
       (void)idx;
       ++counts[kf];
     }
@@ -35,27 +35,27 @@ void Tracker::UpdateLocalMap(const Frame& frame) {
   // K2: the best covisibles of K1, children and parent.
   const size_t k1 = local_keyframes_.size();
   for (size_t k = 0; k < k1 && static_cast<int>(local_keyframes_.size()) < options_.max_local_keyframes; ++k) {
-    const KeyFrame& kf = map_->keyframe(local_keyframes_[k]);
-    std::vector<KeyFrameId> more = map_->BestCovisibles(kf.id, 10);
+    const KeyFrame& kf = map.keyframe(local_keyframes_[k]);
+    std::vector<KeyFrameId> more = map.BestCovisibles(kf.id, kLocalMapCovisibles);
     more.insert(more.end(), kf.children.begin(), kf.children.end());
     if (kf.parent != kNoKeyFrame) more.push_back(kf.parent);
     for (KeyFrameId n : more) {
       if (static_cast<int>(local_keyframes_.size()) >= options_.max_local_keyframes) break;
-      if (map_->HasKeyFrame(n) && in_local.insert(n).second) local_keyframes_.push_back(n);
+      if (map.HasKeyFrame(n) && in_local.insert(n).second) local_keyframes_.push_back(n);
     }
   }
   if (best != kNoKeyFrame) reference_kf_ = best;
   local_landmarks_.clear();
   std::set<LandmarkId> seen;
   for (KeyFrameId kf_id : local_keyframes_) {
-    for (LandmarkId id : map_->keyframe(kf_id).landmarks) {
+    for (LandmarkId id : map.keyframe(kf_id).landmarks) {
       if (id != kNoLandmark && seen.insert(id).second) local_landmarks_.push_back(id);
     }
   }
 }
 
-bool Tracker::TrackLocalMap(Frame* frame, int* inliers) {
-  UpdateLocalMap(*frame);
+bool Tracker::TrackLocalMap(Map& map, Frame* frame, int* inliers) {
+  UpdateLocalMap(map, *frame);
   // Project local landmarks that are not matched yet.
   std::vector<ProjectionCandidate> candidates;
   std::set<LandmarkId> matched;
@@ -66,7 +66,7 @@ bool Tracker::TrackLocalMap(Frame* frame, int* inliers) {
   const Eigen::Vector3d center = pose.Inverse().translation();
   for (LandmarkId id : local_landmarks_) {
     if (matched.count(id)) continue;
-    Landmark& lm = map_->landmark(id);
+    Landmark& lm = map.landmark(id);
     // Frustum check (counts as "visible" for the found ratio).
     const Eigen::Vector3d pc = pose * lm.position;
     if (pc.z() <= 0 || !camera_.InImage(camera_.Project(pc))) continue;
@@ -76,34 +76,34 @@ bool Tracker::TrackLocalMap(Frame* frame, int* inliers) {
     ++lm.visible;
     candidates.push_back(CandidateFromLandmark(lm));
   }
-  for (LandmarkId id : matched) ++map_->landmark(id).visible;
+  for (LandmarkId id : matched) ++map.landmark(id).visible;
   ProjectionSearchOptions opt;
   opt.window = options_.local_map_window;
-  if (frame->index < last_reloc_frame_ + 2) opt.window = 5.0;
-  opt.ratio = 0.8;
+  if (frame->index < last_reloc_frame_ + 2) opt.window = kRelocLocalMapWindow;
+  opt.ratio = kLocalMapRatio;
   const std::vector<bool> taken = TakenMask(*frame);
-  const std::vector<int> m = SearchByProjection(camera_, map_->scale(), *frame->features, pose, candidates, taken, opt);
+  const std::vector<int> m = SearchByProjection(camera_, map.scale(), *frame->features, pose, candidates, taken, opt);
   for (size_t c = 0; c < candidates.size(); ++c) {
     if (m[c] >= 0) frame->landmarks[static_cast<size_t>(m[c])] = candidates[c].landmark;
   }
-  temp_matched_.assign(frame->size(), false);
-  *inliers = OptimizeFramePose(frame, false);
+  scratch_.ClearTemporaryMatches();
+  *inliers = OptimizeFramePose(map, frame, false);
   for (size_t i = 0; i < frame->size(); ++i) {
-    if (frame->landmarks[i] != kNoLandmark) ++map_->landmark(frame->landmarks[i]).found;
+    if (frame->landmarks[i] != kNoLandmark) ++map.landmark(frame->landmarks[i]).found;
   }
   const int needed = frame->index < last_reloc_frame_ + options_.max_frames_between_keyframes
-                         ? 50 : options_.min_local_map_inliers;
+                         ? kRelocalizationInliers : options_.min_local_map_inliers;
   return *inliers >= needed;
 }
 
-bool Tracker::Relocalize(Frame* frame) {
+bool Tracker::Relocalize(const Map& map, Frame* frame) {
   // Candidates: every keyframe, newest first (no place-recognition index yet); the first one
   // that yields a verified pose wins.
   const FrameFeatures& f = *frame->features;
   std::vector<KeyFrameId> kfs;
-  for (auto it = map_->keyframes().rbegin(); it != map_->keyframes().rend(); ++it) kfs.push_back(it->first);
+  for (auto it = map.keyframes().rbegin(); it != map.keyframes().rend(); ++it) kfs.push_back(it->first);
   for (KeyFrameId kf_id : kfs) {
-    const std::vector<LandmarkId> matched = MatchKeyFrameLandmarks(map_->keyframe(kf_id), f, 0.75, kThLow);
+    const std::vector<LandmarkId> matched = MatchKeyFrameLandmarks(map.keyframe(kf_id), f, kRelocalizationRatio, kThLow);
     std::vector<size_t> kp_index;
     std::vector<Eigen::Vector3d> pts;
     std::vector<Eigen::Vector2d> px;
@@ -111,11 +111,11 @@ bool Tracker::Relocalize(Frame* frame) {
     for (size_t i = 0; i < matched.size(); ++i) {
       if (matched[i] == kNoLandmark) continue;
       kp_index.push_back(i);
-      pts.push_back(map_->landmark(matched[i]).position);
+      pts.push_back(map.landmark(matched[i]).position);
       px.push_back(f.undist[i]);
-      sigma2.push_back(map_->scale().level_sigma2[static_cast<size_t>(f.keypoints[i].octave)]);
+      sigma2.push_back(map.scale().level_sigma2[static_cast<size_t>(f.keypoints[i].octave)]);
     }
-    if (kp_index.size() < 15) continue;
+    if (kp_index.size() < kMinRelocalizationMatches) continue;
     RansacOptions ro;
     const PnpResult pnp = SolvePnpRansac(camera_, pts, px, sigma2, ro, rng_);
     if (!pnp.success) continue;
@@ -124,29 +124,29 @@ bool Tracker::Relocalize(Frame* frame) {
       if (pnp.inliers[k]) frame->landmarks[kp_index[k]] = matched[kp_index[k]];
     }
     frame->cam_from_world = pnp.cam_from_world;
-    temp_matched_.assign(frame->size(), false);
-    int inliers = OptimizeFramePose(frame, false);
-    if (inliers < 10) continue;
-    if (inliers < 50) {
+    scratch_.ClearTemporaryMatches();
+    int inliers = OptimizeFramePose(map, frame, false);
+    if (inliers < kMinRelocalizationPnpInliers) continue;
+    if (inliers < kRelocalizationInliers) {
       // Widen with the keyframe's neighbourhood by projection.
       reference_kf_ = kf_id;
-      UpdateLocalMap(*frame);
+      UpdateLocalMap(map, *frame);
       std::vector<ProjectionCandidate> cands;
       for (LandmarkId id : local_landmarks_) {
-        const Landmark& lm = map_->landmark(id);
+        const Landmark& lm = map.landmark(id);
         cands.push_back(CandidateFromLandmark(lm));
       }
       const std::vector<bool> taken = TakenMask(*frame);
       ProjectionSearchOptions po;
-      po.window = 10;
-      po.ratio = 0.9;
-      const std::vector<int> m = SearchByProjection(camera_, map_->scale(), f, *frame->cam_from_world, cands, taken, po);
+      po.window = kRelocalizationWindow;
+      po.ratio = kRelocalizationProjectionRatio;
+      const std::vector<int> m = SearchByProjection(camera_, map.scale(), f, *frame->cam_from_world, cands, taken, po);
       for (size_t c = 0; c < cands.size(); ++c) {
         if (m[c] >= 0) frame->landmarks[static_cast<size_t>(m[c])] = cands[c].landmark;
       }
-      inliers = OptimizeFramePose(frame, false);
+      inliers = OptimizeFramePose(map, frame, false);
     }
-    if (inliers >= 50) {
+    if (inliers >= kRelocalizationInliers) {
       reference_kf_ = kf_id;
       spdlog::info("frame {}: relocalised against keyframe {} ({} inliers)", frame->index, kf_id, inliers);
       return true;
@@ -156,13 +156,13 @@ bool Tracker::Relocalize(Frame* frame) {
   return false;
 }
 
-bool Tracker::NeedNewKeyFrame(const Frame& frame, int inliers) const {
-  const int num_kfs = static_cast<int>(map_->NumKeyFrames());
+bool Tracker::NeedNewKeyFrame(const Map& map, const Frame& frame, int inliers) const {
+  const int num_kfs = static_cast<int>(map.NumKeyFrames());
   const int max_frames = options_.max_frames_between_keyframes;
   if (frame.index < last_reloc_frame_ + max_frames && num_kfs > max_frames) return false;
   // ORB-SLAM counts an RGB-D observation twice; in keyframes its 2 (3) observations are 1 (2).
   const int min_obs = num_kfs <= 2 ? 1 : 2;
-  const int ref_matches = map_->HasKeyFrame(reference_kf_) ? map_->TrackedLandmarks(reference_kf_, min_obs) : 0;
+  const int ref_matches = map.HasKeyFrame(reference_kf_) ? map.TrackedLandmarks(reference_kf_, min_obs) : 0;
   int tracked_close = 0, untracked_close = 0;
   const FrameFeatures& f = *frame.features;
   for (size_t i = 0; i < f.size(); ++i) {
@@ -176,28 +176,28 @@ bool Tracker::NeedNewKeyFrame(const Frame& frame, int inliers) const {
     }
   }
   const bool need_close = tracked_close < options_.close_tracked_max && untracked_close > options_.close_untracked_min;
-  const double th_ref = num_kfs < 2 ? 0.4 : options_.ref_ratio;
+  const double th_ref = num_kfs < 2 ? kNewKeyFrameRefRatioOneKf : options_.ref_ratio;
   const bool c1a = frame.index >= last_keyframe_frame_ + max_frames;
   const bool c1b = true;  // sequential mapping: the local mapper is always idle here
-  const bool c1c = inliers < 0.25 * ref_matches || need_close;
-  const bool c2 = (inliers < th_ref * ref_matches || need_close) && inliers > 15;
+  const bool c1c = inliers < kNewKeyFrameLowRatio * ref_matches || need_close;
+  const bool c2 = (inliers < th_ref * ref_matches || need_close) && inliers > kMinKeyFrameInliers;
   return (c1a || c1b || c1c) && c2;
 }
 
-KeyFrameId Tracker::CreateKeyFrame(Frame* frame) {
+KeyFrameId Tracker::CreateKeyFrame(Map& map, Frame* frame) {
   KeyFrame kf;
   kf.frame_index = frame->index;
   kf.stamp = frame->stamp;
   kf.cam_from_world = *frame->cam_from_world;
   kf.features = frame->features;
   kf.labels = frame->labels;
-  const KeyFrameId id = map_->AddKeyFrame(std::move(kf));
+  const KeyFrameId id = map.AddKeyFrame(std::move(kf));
   for (size_t i = 0; i < frame->size(); ++i) {
     const LandmarkId lm = frame->landmarks[i];
-    if (lm != kNoLandmark && map_->HasLandmark(lm)) map_->AddObservation(lm, id, i);
+    if (lm != kNoLandmark && map.HasLandmark(lm)) map.AddObservation(lm, id, i);
   }
-  CreateLandmarksFromDepth(frame, id);
-  map_->UpdateConnections(id);
+  CreateLandmarksFromDepth(map, frame, id);
+  map.UpdateConnections(id);
   reference_kf_ = id;
   last_keyframe_ = id;
   last_keyframe_frame_ = frame->index;
@@ -205,27 +205,27 @@ KeyFrameId Tracker::CreateKeyFrame(Frame* frame) {
   if (last_frame_ && last_frame_->index == frame->index) {
     last_frame_->landmarks = frame->landmarks;
     last_frame_->reference_keyframe = id;
-    BuildTemporaryPoints();
+    BuildTemporaryPoints(map);
   }
   return id;
 }
 
-KeyFrameId Tracker::CreateLandmarksFromDepth(Frame* frame, KeyFrameId kf_id) {
+KeyFrameId Tracker::CreateLandmarksFromDepth(Map& map, Frame* frame, KeyFrameId kf_id) {
   const FrameFeatures& f = *frame->features;
   std::vector<std::pair<float, size_t>> by_depth;
   for (size_t i = 0; i < f.size(); ++i) {
     const bool mover = !frame->labels.empty() && frame->labels[i] != KeypointLabel::kStatic;
-    if (f.depth[i] > 0 && f.labels[i] == KeypointLabel::kStatic && !mover) by_depth.emplace_back(f.depth[i], i);
+    if (f.depth[i] > 0 && !mover) by_depth.emplace_back(f.depth[i], i);
   }
   std::sort(by_depth.begin(), by_depth.end());
   const Rigid3d world_from_cam = frame->cam_from_world->Inverse();
   int created = 0;
   for (const auto& [d, i] : by_depth) {
     if (frame->landmarks[i] == kNoLandmark) {
-      const LandmarkId lm = map_->AddLandmark(world_from_cam * camera_.Unproject(f.undist[i], d), kf_id);
-      map_->AddObservation(lm, kf_id, i);
-      map_->UpdateLandmarkGeometry(lm);
-      map_->UpdateLandmarkDescriptor(lm);
+      const LandmarkId lm = map.AddLandmark(world_from_cam * camera_.Unproject(f.undist[i], d), kf_id);
+      map.AddObservation(lm, kf_id, i);
+      map.UpdateLandmarkGeometry(lm);
+      map.UpdateLandmarkDescriptor(lm);
       frame->landmarks[i] = lm;
       ++created;
     }

@@ -1,0 +1,84 @@
+#include "detslam/dynamic/detslam_stage.h"
+
+#include <algorithm>
+#include <chrono>
+
+#include "detslam/core/check.h"
+
+namespace detslam {
+
+bool DetSlamOptions::Check(std::string* error) const {
+  std::string e;
+  if (!filter.Check(&e)) {
+    if (error) *error = "dynamic filter: " + e;
+    return false;
+  }
+  if (!geometric.Check(&e)) {
+    if (error) *error = "geometric check: " + e;
+    return false;
+  }
+  if (!propagation.Check(&e)) {
+    if (error) *error = "mask propagation: " + e;
+    return false;
+  }
+  if (memory_frames < 0 || segment_every < 1) {
+    if (error) *error = "memory_frames must be >= 0 and segment_every >= 1";
+    return false;
+  }
+  if (error) error->clear();
+  return true;
+}
+
+DetSlamStage::DetSlamStage(DetSlamOptions options, Segmenter* segmenter)
+    : options_(std::move(options)),
+      segmenter_(segmenter),
+      memory_(options_.memory_frames),
+      propagator_(options_.propagation) {
+  std::string error;
+  DETSLAM_CHECK_MSG(options_.Check(&error), "invalid DetSlamOptions: " << error);
+}
+
+FrameInstances DetSlamStage::Segment(const SegmenterInput& input, const cv::Mat& gray) {
+  FrameInstances out;
+  if (segmenter_ == nullptr) return out;
+  const auto t0 = std::chrono::steady_clock::now();
+  const int every = options_.segment_every;
+  if (every > 1 && input.index % every != 0) {
+    out.instances = propagator_.Propagate(gray);
+  } else {
+    out.instances = memory_.Update(segmenter_->Segment(input));
+    if (every > 1) propagator_.Reset(gray, out.instances);
+  }
+  out.segmented = true;
+  out.segmentation_ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  return out;
+}
+
+LabelledKeypoints DetSlamStage::Extract(const OrbExtractor& extractor, const cv::Mat& gray,
+                                        const cv::Mat& depth_m, const cv::Mat& ignore_mask,
+                                        const std::vector<Instance>* instances) const {
+  LabelledKeypoints out;
+  DynamicRegions regions;
+  if (instances != nullptr) {
+    regions = DynamicRegions::Build(*instances, depth_m, gray.size(), options_.filter);
+  }
+  cv::Mat mask = ignore_mask;
+  if (instances != nullptr && options_.premask && !instances->empty()) {
+    const cv::Mat dynamic = regions.IgnoreMask(depth_m);
+    if (mask.empty()) {
+      mask = dynamic;
+    } else {
+      cv::bitwise_or(mask, dynamic, mask);
+    }
+  }
+  extractor.Extract(gray, mask, &out.keypoints, &out.descriptors);
+  out.depth = SampleKeypointDepth(out.keypoints, depth_m);
+  out.labels.assign(out.keypoints.size(), KeypointLabel::kStatic);
+  if (instances != nullptr) {
+    out.instances_used = regions.Label(out.keypoints, out.depth, &out.labels).instances_used;
+  }
+  return out;
+}
+
+}  // namespace detslam

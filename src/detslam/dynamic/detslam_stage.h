@@ -1,0 +1,80 @@
+// The Det-SLAM stage: everything detslam does about dynamic objects, in one object with one
+// options struct, turning a frame plus its instances into one label per keypoint, computed once.
+//  - Loader side (Segment; not const, frames in input order): the segmenter on every
+//    `segment_every`-th frame, lost instances carried forward (InstanceMemory), masks moved by
+//    optical flow in between (MaskPropagator).
+//  - Extraction side (Extract; const, may run in another thread): the frame's instances are
+//    rasterised once (DynamicRegions: dilated masks, depth intervals), their pixel form goes to
+//    the ORB extractor (premask), each keypoint's depth is sampled once and every keypoint gets its
+//    label (mask step, depth step).
+//  - The geometric check for movers the segmenter missed needs the tracked pose: the tracker runs
+//    it (tracking/tracker_geometric.cc) with this stage's `geometric` options.
+#pragma once
+
+#include <opencv2/core.hpp>
+#include <string>
+#include <vector>
+
+#include "detslam/dynamic/dynamic_filter.h"
+#include "detslam/dynamic/geometric_check.h"
+#include "detslam/dynamic/instance_memory.h"
+#include "detslam/dynamic/mask_propagation.h"
+#include "detslam/features/orb_extractor.h"
+#include "detslam/segmentation/segmenter.h"
+
+namespace detslam {
+
+struct DetSlamOptions {
+  DynamicFilterOptions filter;  // mask step and depth step (Det-SLAM eqs. 1-6)
+  bool premask = true;          // also drop dynamic corners before the ORB spatial distribution
+  int memory_frames = 3;        // carry lost instances forward this many frames (0.1 s)
+  int segment_every = 1;        // segmenter on every k-th frame; masks follow the flow in between
+  MaskPropagationOptions propagation;  // how masks move between segmented frames
+  MoverCheckOptions geometric;  // geometric check for movers the segmenter missed (tracker)
+
+  bool Check(std::string* error) const;
+};
+
+// The instances of one frame from the loader side.
+struct FrameInstances {
+  std::vector<Instance> instances;
+  bool segmented = false;      // the stage ran for this frame (a segmenter is set)
+  double segmentation_ms = 0;  // time of the segmenter (or the mask propagation)
+};
+
+// Extraction output with the stage's decision per keypoint.
+struct LabelledKeypoints {
+  std::vector<cv::KeyPoint> keypoints;
+  cv::Mat descriptors;                 // one row per keypoint
+  std::vector<float> depth;            // per keypoint (SampleKeypointDepth), <= 0 unknown
+  std::vector<KeypointLabel> labels;   // per keypoint: kStatic, kDynamicMask or kDynamicDepth
+  int instances_used = 0;              // dynamic instances the filter used
+};
+
+class DetSlamStage {
+ public:
+  // `segmenter` may be null: then Segment reports no instances and Extract labels nothing.
+  DetSlamStage(DetSlamOptions options, Segmenter* segmenter);
+
+  // Loader side: the dynamic instances of the frame `input` describes (`gray`: its CV_8UC1 image,
+  // for the mask propagation). Frames must come in input order.
+  FrameInstances Segment(const SegmenterInput& input, const cv::Mat& gray);
+
+  // Extraction side: ORB keypoints of `gray` with their depth and labels. `instances`: null when
+  // the frame was not segmented (every keypoint static). `ignore_mask`: empty or CV_8UC1,
+  // non-zero = no keypoints there.
+  LabelledKeypoints Extract(const OrbExtractor& extractor, const cv::Mat& gray,
+                            const cv::Mat& depth_m, const cv::Mat& ignore_mask,
+                            const std::vector<Instance>* instances) const;
+
+  const DetSlamOptions& options() const { return options_; }
+  bool has_segmenter() const { return segmenter_ != nullptr; }
+
+ private:
+  DetSlamOptions options_;
+  Segmenter* segmenter_;
+  InstanceMemory memory_;      // detections lost for a frame or two
+  MaskPropagator propagator_;  // masks between segmented frames (segment_every > 1)
+};
+
+}  // namespace detslam

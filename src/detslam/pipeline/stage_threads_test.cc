@@ -1,0 +1,69 @@
+#include "detslam/pipeline/stage_threads.h"
+
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <stdexcept>
+
+#include "detslam/pipeline/bounded_queue.h"
+
+namespace detslam {
+namespace {
+
+TEST(StageThreads, AllStagesRunAndJoinReturns) {
+  BoundedQueue<int> q(2);
+  StageThreads stages([&] { q.Close(); });
+  std::atomic<int> sum{0};
+  stages.Start("producer", [&] {
+    for (int i = 1; i <= 100; ++i) q.Push(i);
+  }, [&] { q.Close(); });
+  stages.RunHere("consumer", [&] {
+    while (std::optional<int> v = q.Pop()) sum += *v;
+  });
+  stages.Join();
+  EXPECT_EQ(sum.load(), 5050);
+}
+
+// A failing stage stops the others (which would otherwise block forever on their queues) and
+// its exception reaches Join's caller instead of std::terminate.
+TEST(StageThreads, AFailingStageEndsTheRunWithItsMessage) {
+  BoundedQueue<int> a(1), b(1);
+  StageThreads stages([&] {
+    a.Close();
+    b.Close();
+  });
+  stages.Start("endless producer", [&] {
+    for (int i = 0;; ++i) {
+      if (!a.Push(i)) return;  // closed by the failing stage
+    }
+  });
+  stages.Start("failing", [&] {
+    for (int k = 0; k < 10; ++k) a.Pop();
+    throw std::runtime_error("disk full in stage two");
+  });
+  stages.RunHere("waiting consumer", [&] {
+    while (b.Pop()) {
+    }
+  });
+  try {
+    stages.Join();
+    FAIL() << "Join did not rethrow";
+  } catch (const std::runtime_error& e) {
+    EXPECT_STREQ(e.what(), "disk full in stage two");
+  }
+}
+
+TEST(StageThreads, TheFirstErrorWins) {
+  StageThreads stages(nullptr);
+  stages.RunHere("first", [] { throw std::runtime_error("first"); });
+  stages.RunHere("second", [] { throw std::runtime_error("second"); });
+  try {
+    stages.Join();
+    FAIL() << "Join did not rethrow";
+  } catch (const std::runtime_error& e) {
+    EXPECT_STREQ(e.what(), "first");
+  }
+}
+
+}  // namespace
+}  // namespace detslam
