@@ -1,4 +1,5 @@
-// detslam run: SLAM over a TUM/Bonn-layout RGB-D folder (sequential mode).
+// detslam run: SLAM over a TUM/Bonn-layout RGB-D folder (sequential by default; --threaded runs one
+// thread per stage).
 #include <unistd.h>
 
 #include <cstdio>

@@ -2,10 +2,13 @@
 // truth, asserting tracked fraction and accuracy, and determinism of sequential runs.
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 
+#include "detslam/core/check.h"
 #include "detslam/eval/evaluate.h"
 #include "detslam/io/dataset.h"
 #include "detslam/io/settings.h"
@@ -20,7 +23,8 @@ namespace {
 namespace fs = std::filesystem;
 
 std::string TempDir(const std::string& name) {
-  const fs::path p = fs::temp_directory_path() / ("detslam_it_" + name);
+  // Per process, so that two test runs on one machine do not share folders.
+  const fs::path p = fs::temp_directory_path() / ("detslam_it_" + std::to_string(::getpid()) + "_" + name);
   fs::remove_all(p);
   fs::create_directories(p);
   return p.string();
@@ -124,6 +128,48 @@ TEST(IntegrationSlamDynamic, GroundTruthMasksRemoveThePeople) {
   int frames_with_people = 0;
   for (const FrameReport& r : with_gt.summary.reports) frames_with_people += r.dynamic_instances > 0 ? 1 : 0;
   EXPECT_GT(frames_with_people, 100) << "the filter saw people in too few frames";
+}
+
+// A segmenter that fails on frame `fail_at` (as a model file that cannot be read would).
+class FailingSegmenter : public Segmenter {
+ public:
+  explicit FailingSegmenter(int64_t fail_at) : fail_at_(fail_at) {}
+  std::vector<Instance> Segment(const SegmenterInput& input) override {
+    if (input.index == fail_at_) throw InputError("model.onnx", 0, "segmenter failed on frame " + std::to_string(fail_at_));
+    return {};
+  }
+  std::string name() const override { return "failing"; }
+
+ private:
+  int64_t fail_at_;
+};
+
+// A stage that throws in its own thread ends the run with its message (no std::terminate, no
+// hang), in every mode, and leaves no trajectory behind.
+TEST(IntegrationRunner, AFailingStageEndsTheRunWithItsMessage) {
+  const std::string seq = TempDir("failing_stage");
+  SynthOptions so;
+  so.preset = "static";
+  so.seed = 1;
+  so.frames = 40;
+  WriteSequence(so, seq);
+  const RgbdDataset dataset = RgbdDataset::Open(seq, {});
+  const Settings settings = PresetForDataset(seq);
+  for (const auto& [threaded, mapping_thread] : {std::pair{false, false}, {true, false}, {true, true}}) {
+    RunOptions options;
+    options.out_dir = TempDir("failing_stage_run");
+    options.threaded = threaded;
+    options.mapping_thread = mapping_thread;
+    options.slam = SlamOptionsFromSettings(settings, 42);
+    FailingSegmenter segmenter(25);
+    try {
+      detslam::Run(dataset, settings, options, nullptr, &segmenter);
+      ADD_FAILURE() << "no error (threaded " << threaded << ", mapping thread " << mapping_thread << ")";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("segmenter failed on frame 25"), std::string::npos) << e.what();
+    }
+    EXPECT_FALSE(fs::exists(fs::path(options.out_dir) / "trajectory.txt"));
+  }
 }
 
 TEST(IntegrationSlamSynthetic, StaticPresetTracksEveryFrameWithinOneCentimetre) {

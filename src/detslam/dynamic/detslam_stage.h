@@ -30,7 +30,7 @@ struct DetSlamOptions {
   int memory_frames = 3;        // carry lost instances forward this many frames (0.1 s)
   int segment_every = 1;        // segmenter on every k-th frame; masks follow the flow in between
   MaskPropagationOptions propagation;  // how masks move between segmented frames
-  MoverCheckOptions geometric;  // geometric check for movers the segmenter missed (tracker)
+  MoverCheckOptions geometric;         // geometric check for movers the segmenter missed (tracker)
 
   bool Check(std::string* error) const;
 };
@@ -45,10 +45,10 @@ struct FrameInstances {
 // Extraction output with the stage's decision per keypoint.
 struct LabelledKeypoints {
   std::vector<cv::KeyPoint> keypoints;
-  cv::Mat descriptors;                 // one row per keypoint
-  std::vector<float> depth;            // per keypoint (SampleKeypointDepth), <= 0 unknown
-  std::vector<KeypointLabel> labels;   // per keypoint: kStatic, kDynamicMask or kDynamicDepth
-  int instances_used = 0;              // dynamic instances the filter used
+  cv::Mat descriptors;                // one row per keypoint
+  std::vector<float> depth;           // per keypoint (SampleKeypointDepth), <= 0 unknown
+  std::vector<KeypointLabel> labels;  // per keypoint: kStatic, kDynamicMask or kDynamicDepth
+  int instances_used = 0;             // dynamic instances the filter used
 };
 
 class DetSlamStage {

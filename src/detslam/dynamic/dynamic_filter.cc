@@ -208,8 +208,8 @@ DepthInterval ObjectDepthInterval(const cv::Mat& depth_m, const cv::Mat& mask, c
   return out;
 }
 
-DynamicRegions DynamicRegions::Build(const std::vector<Instance>& instances,
-                                     const cv::Mat& depth_m, const cv::Size& image_size,
+DynamicRegions DynamicRegions::Build(const std::vector<Instance>& instances, const cv::Mat& depth_m,
+                                     const cv::Size& image_size,
                                      const DynamicFilterOptions& options) {
   CheckOptions(options);
   CheckDepth(depth_m);

@@ -228,8 +228,7 @@ TEST(LabelDynamicKeypointsTest, PersonInFrontOfWall) {
   no_depth_step.depth_step = false;
   const Labelled mask_only = Label(points, {scene.Person()}, scene.depth, no_depth_step);
   EXPECT_EQ(mask_only.labels, (std::vector<KeypointLabel>{M, M, M, S, S, S, S, S, S, S}));
-  const Labelled no_depth_image =
-      Label(points, {scene.Person()}, cv::Mat(), SceneOptions());
+  const Labelled no_depth_image = Label(points, {scene.Person()}, cv::Mat(), SceneOptions());
   EXPECT_EQ(no_depth_image.labels, mask_only.labels);
 }
 

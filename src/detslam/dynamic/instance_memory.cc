@@ -19,7 +19,8 @@ std::vector<Instance> InstanceMemory::Update(const std::vector<Instance>& curren
     for (const Remembered& r : remembered_) {
       bool covered = false;
       for (const Instance& c : current) {
-        if (c.class_name == r.instance.class_name && BoxIouOf(c.box, r.instance.box) >= min_iou_) covered = true;
+        if (c.class_name == r.instance.class_name && BoxIouOf(c.box, r.instance.box) >= min_iou_)
+          covered = true;
       }
       if (covered || r.age + 1 > max_age_) continue;
       out.push_back(r.instance);

@@ -19,7 +19,8 @@ double MedianOf(std::vector<float> v) {
 cv::Mat Grow(const cv::Mat& mask, int px) {
   if (mask.empty() || px <= 0) return mask;
   cv::Mat out;
-  cv::dilate(mask, out, cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * px + 1, 2 * px + 1)));
+  cv::dilate(mask, out,
+             cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * px + 1, 2 * px + 1)));
   return out;
 }
 
@@ -85,16 +86,21 @@ std::vector<Instance> MaskPropagator::Propagate(const cv::Mat& gray) {
       }
     }
     inst.mask = ShiftMask(inst.mask, dx, dy);
-    inst.box = cv::Rect(cvRound(inst.box.x + dx), cvRound(inst.box.y + dy), inst.box.width, inst.box.height) & image;
+    inst.box = cv::Rect(cvRound(inst.box.x + dx), cvRound(inst.box.y + dy), inst.box.width,
+                        inst.box.height) &
+               image;
   }
-  instances_.erase(std::remove_if(instances_.begin(), instances_.end(), [](const Instance& i) { return i.box.empty(); }),
+  instances_.erase(std::remove_if(instances_.begin(), instances_.end(),
+                                  [](const Instance& i) { return i.box.empty(); }),
                    instances_.end());  // moved out of view
   last_gray_ = gray.clone();
   std::vector<Instance> out = instances_;
   const int grow = options_.grow_px_per_frame * age_;
   for (Instance& inst : out) {
     inst.mask = Grow(inst.mask, grow);
-    inst.box = cv::Rect(inst.box.x - grow, inst.box.y - grow, inst.box.width + 2 * grow, inst.box.height + 2 * grow) & image;
+    inst.box = cv::Rect(inst.box.x - grow, inst.box.y - grow, inst.box.width + 2 * grow,
+                        inst.box.height + 2 * grow) &
+               image;
   }
   return out;
 }

@@ -14,9 +14,9 @@
 namespace detslam {
 
 struct MaskPropagationOptions {
-  int max_corners = 80;        // corners tracked per instance
-  int grow_px_per_frame = 2;   // mask dilation added per frame since the last segmentation
-  int min_tracked = 3;         // fewer tracked corners: the instance keeps its place (still grown)
+  int max_corners = 80;       // corners tracked per instance
+  int grow_px_per_frame = 2;  // mask dilation added per frame since the last segmentation
+  int min_tracked = 3;        // fewer tracked corners: the instance keeps its place (still grown)
   bool Check(std::string* error) const;
 };
 

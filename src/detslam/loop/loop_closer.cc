@@ -22,7 +22,8 @@ bool LoopClosingOptions::Check(std::string* error) const {
   if (min_keyframe_gap < 1) os << "min_keyframe_gap must be >= 1; ";
   if (!(candidate_radius_m > 0)) os << "candidate_radius_m must be positive; ";
   if (max_candidates < 1) os << "max_candidates must be >= 1; ";
-  if (min_matches < 3 || min_ransac_inliers < 3) os << "min_matches and min_ransac_inliers must be >= 3; ";
+  if (min_matches < 3 || min_ransac_inliers < 3)
+    os << "min_matches and min_ransac_inliers must be >= 3; ";
   if (!(ransac_inlier_m > 0)) os << "ransac_inlier_m must be positive; ";
   if (min_verified_inliers < 3) os << "min_verified_inliers must be >= 3; ";
   if (error) *error = os.str();
@@ -50,8 +51,10 @@ LoopClosingResult LoopCloser::Process(Map& map, KeyFrameId kf_id) {
     if (d < options_.candidate_radius_m) near.emplace_back(d, id);
   }
   std::sort(near.begin(), near.end());
-  spdlog::debug("keyframe {}: {} loop candidates within {} m", kf_id, near.size(), options_.candidate_radius_m);
-  if (near.size() > static_cast<size_t>(options_.max_candidates)) near.resize(static_cast<size_t>(options_.max_candidates));
+  spdlog::debug("keyframe {}: {} loop candidates within {} m", kf_id, near.size(),
+                options_.candidate_radius_m);
+  if (near.size() > static_cast<size_t>(options_.max_candidates))
+    near.resize(static_cast<size_t>(options_.max_candidates));
   for (const auto& [d, candidate] : near) {
     (void)d;
     Verified loop;
@@ -62,8 +65,10 @@ LoopClosingResult LoopCloser::Process(Map& map, KeyFrameId kf_id) {
     result.inliers = loop.inliers;
     last_loop_kf_ = kf_id;
     ++loops_closed_;
-    spdlog::info("loop closed: keyframe {} with keyframe {} ({} inliers, {} landmarks fused, correction {:.3f} m)",
-                 kf_id, candidate, loop.inliers, result.fused, result.correction_m);
+    spdlog::info(
+        "loop closed: keyframe {} with keyframe {} ({} inliers, {} landmarks fused, correction "
+        "{:.3f} m)",
+        kf_id, candidate, loop.inliers, result.fused, result.correction_m);
     break;
   }
   return result;
@@ -72,7 +77,8 @@ LoopClosingResult LoopCloser::Process(Map& map, KeyFrameId kf_id) {
 bool LoopCloser::Verify(const Map& map, KeyFrameId kf_id, KeyFrameId candidate_id, Verified* out) {
   const KeyFrame& kf = map.keyframe(kf_id);
   const FrameFeatures& f = *kf.features;
-  std::vector<LandmarkId> matched = MatchKeyFrameLandmarks(map.keyframe(candidate_id), f, 0.9, kThHigh);
+  std::vector<LandmarkId> matched =
+      MatchKeyFrameLandmarks(map.keyframe(candidate_id), f, 0.9, kThHigh);
   std::vector<Eigen::Vector3d> world, cam;
   std::vector<size_t> kp;
   for (size_t i = 0; i < f.size(); ++i) {
@@ -81,7 +87,8 @@ bool LoopCloser::Verify(const Map& map, KeyFrameId kf_id, KeyFrameId candidate_i
     cam.push_back(camera_.Unproject(f.undist[i], f.depth[i]));
     kp.push_back(i);
   }
-  spdlog::debug("loop candidate {} for keyframe {}: {} matches with depth", candidate_id, kf_id, kp.size());
+  spdlog::debug("loop candidate {} for keyframe {}: {} matches with depth", candidate_id, kf_id,
+                kp.size());
   if (static_cast<int>(kp.size()) < options_.min_matches) return false;
   RansacOptions ro;
   ro.min_inliers = options_.min_ransac_inliers;
@@ -128,7 +135,8 @@ bool LoopCloser::Verify(const Map& map, KeyFrameId kf_id, KeyFrameId candidate_i
   ProjectionSearchOptions po;
   po.window = 10;
   po.ratio = 0.9;
-  const std::vector<int> m = SearchByProjection(camera_, map.scale(), f, pose, candidates, taken, po);
+  const std::vector<int> m =
+      SearchByProjection(camera_, map.scale(), f, pose, candidates, taken, po);
   for (size_t c = 0; c < candidates.size(); ++c) {
     if (m[c] >= 0) assoc[static_cast<size_t>(m[c])] = candidates[c].landmark;
   }
@@ -142,7 +150,8 @@ bool LoopCloser::Verify(const Map& map, KeyFrameId kf_id, KeyFrameId candidate_i
   return true;
 }
 
-void LoopCloser::Correct(Map& map, KeyFrameId kf_id, const Verified& loop, LoopClosingResult* result) {
+void LoopCloser::Correct(Map& map, KeyFrameId kf_id, const Verified& loop,
+                         LoopClosingResult* result) {
   // Poses and positions before the correction.
   std::map<KeyFrameId, Rigid3d> old_pose;
   for (const auto& [id, k] : map.keyframes()) old_pose[id] = k.cam_from_world;
@@ -219,8 +228,10 @@ void LoopCloser::Correct(Map& map, KeyFrameId kf_id, const Verified& loop, LoopC
     }
   }
   const PoseGraphSummary s = SolvePoseGraph(&problem, PoseGraphOptions());
-  if (!s.usable) spdlog::warn("loop closing: pose graph optimisation did not converge; using its last state");
-  for (const PoseGraphProblem::Node& n : problem.nodes) map.keyframe(n.id).cam_from_world = n.cam_from_world;
+  if (!s.usable)
+    spdlog::warn("loop closing: pose graph optimisation did not converge; using its last state");
+  for (const PoseGraphProblem::Node& n : problem.nodes)
+    map.keyframe(n.id).cam_from_world = n.cam_from_world;
 
   // Every landmark moves with its reference keyframe.
   for (const auto& [id, pos] : old_position) {
@@ -235,8 +246,10 @@ void LoopCloser::Correct(Map& map, KeyFrameId kf_id, const Verified& loop, LoopC
     lm.position = map.keyframe(ref).cam_from_world.Inverse() * (old_pose.at(ref) * pos);
     map.UpdateLandmarkGeometry(id);
   }
-  if (options_.global_ba_iterations > 0) GlobalBundleAdjustment(camera_, options_.global_ba_iterations, &map);
-  result->correction_m = (map.keyframe(kf_id).Center() - old_pose.at(kf_id).Inverse().translation()).norm();
+  if (options_.global_ba_iterations > 0)
+    GlobalBundleAdjustment(camera_, options_.global_ba_iterations, &map);
+  result->correction_m =
+      (map.keyframe(kf_id).Center() - old_pose.at(kf_id).Inverse().translation()).norm();
   result->old_poses = std::move(old_pose);
 }
 

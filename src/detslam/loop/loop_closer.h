@@ -23,16 +23,17 @@ namespace detslam {
 
 struct LoopClosingOptions {
   bool enabled = true;
-  int min_keyframe_gap = 20;          // candidates at least this many keyframe ids older
-  double candidate_radius_m = 1.5;    // candidate keyframe centres within this distance
-  int max_candidates = 8;             // examined per keyframe (nearest first)
-  int min_matches = 40;               // descriptor matches with depth to try RANSAC
-  double ransac_inlier_m = 0.05;      // 3-D inlier distance (scaled by depth / 2 m, at least this)
+  int min_keyframe_gap = 20;        // candidates at least this many keyframe ids older
+  double candidate_radius_m = 1.5;  // candidate keyframe centres within this distance
+  int max_candidates = 8;           // examined per keyframe (nearest first)
+  int min_matches = 40;             // descriptor matches with depth to try RANSAC
+  double ransac_inlier_m = 0.05;    // 3-D inlier distance (scaled by depth / 2 m, at least this)
   int min_ransac_inliers = 30;
-  int min_verified_inliers = 80;      // pose-only inliers after the projection search
-  int essential_min_weight = 100;     // covisibility edges kept in the pose graph
-  int global_ba_iterations = 10;      // bundle adjustment of the whole map after the pose graph (0: none)
-  uint64_t seed = 7;                  // RANSAC
+  int min_verified_inliers = 80;   // pose-only inliers after the projection search
+  int essential_min_weight = 100;  // covisibility edges kept in the pose graph
+  int global_ba_iterations =
+      10;             // bundle adjustment of the whole map after the pose graph (0: none)
+  uint64_t seed = 7;  // RANSAC
   bool Check(std::string* error) const;
 };
 
@@ -60,8 +61,8 @@ class LoopCloser {
  private:
   struct Verified {
     KeyFrameId candidate = kNoKeyFrame;
-    Rigid3d cam_from_world;                  // corrected pose of the current keyframe
-    std::vector<LandmarkId> matched;         // per keypoint of the current keyframe
+    Rigid3d cam_from_world;           // corrected pose of the current keyframe
+    std::vector<LandmarkId> matched;  // per keypoint of the current keyframe
     int inliers = 0;
   };
   bool Verify(const Map& map, KeyFrameId kf, KeyFrameId candidate, Verified* out);

@@ -23,9 +23,13 @@ TEST(MapStore, WriteAccessChangesTheMapAndReadAccessSeesIt) {
 TEST(MapStore, ComputeOutsideLockSkipsWhenTheSnapshotIsEmpty) {
   MapStore store(TwoLevels());
   bool solved = false, applied = false;
-  const bool ran = store.ComputeOutsideLock([](const Map&) -> std::optional<int> { return std::nullopt; },
-                                            [&](int&) { solved = true; return 0; },
-                                            [&](Map&, const int&, const int&) { applied = true; });
+  const bool ran =
+      store.ComputeOutsideLock([](const Map&) -> std::optional<int> { return std::nullopt; },
+                               [&](int&) {
+                                 solved = true;
+                                 return 0;
+                               },
+                               [&](Map&, const int&, const int&) { applied = true; });
   EXPECT_FALSE(ran);
   EXPECT_FALSE(solved);
   EXPECT_FALSE(applied);

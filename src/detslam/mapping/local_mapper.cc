@@ -10,9 +10,9 @@
 
 #include "detslam/core/check.h"
 #include "detslam/features/matcher.h"
-#include "detslam/optim/bundle_adjustment.h"
 #include "detslam/map/projection_search.h"
 #include "detslam/mapping/map_bundle.h"
+#include "detslam/optim/bundle_adjustment.h"
 
 namespace detslam {
 
@@ -77,7 +77,8 @@ void LocalMapper::CullLandmarks(Map& map, KeyFrameId current, LocalMappingSummar
 }
 
 void LocalMapper::FuseWithNeighbours(Map& map, KeyFrameId current, LocalMappingSummary* summary) {
-  std::vector<KeyFrameId> targets = map.BestCovisibles(current, static_cast<size_t>(options_.fuse_neighbours));
+  std::vector<KeyFrameId> targets =
+      map.BestCovisibles(current, static_cast<size_t>(options_.fuse_neighbours));
   std::set<KeyFrameId> target_set(targets.begin(), targets.end());
   const size_t first_order = targets.size();
   for (size_t k = 0; k < first_order; ++k) {
@@ -99,7 +100,8 @@ void LocalMapper::FuseWithNeighbours(Map& map, KeyFrameId current, LocalMappingS
       cands.push_back(CandidateFromLandmark(lm));
     }
     const KeyFrame& kf = map.keyframe(into);
-    const std::vector<int> m = SearchByProjection(camera_, map.scale(), *kf.features, kf.cam_from_world, cands, {}, opt);
+    const std::vector<int> m =
+        SearchByProjection(camera_, map.scale(), *kf.features, kf.cam_from_world, cands, {}, opt);
     for (size_t c = 0; c < cands.size(); ++c) {
       if (m[c] < 0 || !map.HasLandmark(cands[c].landmark)) continue;
       const size_t idx = static_cast<size_t>(m[c]);
@@ -148,7 +150,9 @@ void LocalMapper::LocalBundleAdjustment(MapStore* store, KeyFrameId current,
   // observe their points most (up to max_fixed_keyframes) are held fixed.
   auto snapshot = [&](const Map& map) -> std::optional<MapBundle> {
     std::vector<KeyFrameId> local = {current};
-    for (KeyFrameId k : map.BestCovisibles(current, static_cast<size_t>(options_.max_local_keyframes - 1))) local.push_back(k);
+    for (KeyFrameId k :
+         map.BestCovisibles(current, static_cast<size_t>(options_.max_local_keyframes - 1)))
+      local.push_back(k);
     std::set<KeyFrameId> local_set(local.begin(), local.end());
     std::vector<LandmarkId> points;
     std::set<LandmarkId> point_set;
@@ -168,9 +172,12 @@ void LocalMapper::LocalBundleAdjustment(MapStore* store, KeyFrameId current,
     for (const auto& [kf, n] : fixed_counts) fixed_sorted.emplace_back(-n, kf);
     std::sort(fixed_sorted.begin(), fixed_sorted.end());
     std::vector<KeyFrameId> fixed;
-    for (size_t i = 0; i < fixed_sorted.size() && static_cast<int>(i) < options_.max_fixed_keyframes; ++i) fixed.push_back(fixed_sorted[i].second);
+    for (size_t i = 0;
+         i < fixed_sorted.size() && static_cast<int>(i) < options_.max_fixed_keyframes; ++i)
+      fixed.push_back(fixed_sorted[i].second);
     MapBundle bundle = BuildMapBundle(map, local, fixed);
-    if (bundle.problem.poses.empty()) return std::nullopt;  // no gauge: ORB-SLAM skips local BA then
+    if (bundle.problem.poses.empty())
+      return std::nullopt;  // no gauge: ORB-SLAM skips local BA then
     return bundle;
   };
   auto solve = [&](MapBundle& bundle) {
@@ -181,7 +188,8 @@ void LocalMapper::LocalBundleAdjustment(MapStore* store, KeyFrameId current,
   auto apply = [&](Map& map, const MapBundle& bundle, const BundleSummary& s) {
     if (!s.usable) return;
     summary->ba_outliers += ApplyMapBundle(bundle, s, &map);
-    summary->ba_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    summary->ba_ms =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   };
   store->ComputeOutsideLock(snapshot, solve, apply);
 }
@@ -212,7 +220,8 @@ void LocalMapper::CullKeyFrames(Map& map, KeyFrameId current, LocalMappingSummar
       ErasedKeyFrame e;
       e.id = k;
       e.parent = kf.parent;
-      if (map.HasKeyFrame(kf.parent)) e.cam_from_parent = kf.cam_from_world * map.keyframe(kf.parent).cam_from_world.Inverse();
+      if (map.HasKeyFrame(kf.parent))
+        e.cam_from_parent = kf.cam_from_world * map.keyframe(kf.parent).cam_from_world.Inverse();
       map.EraseKeyFrame(k);
       summary->erased_keyframes.push_back(e);
     }

@@ -15,15 +15,15 @@
 namespace detslam {
 
 struct LocalMapperOptions {
-  bool local_ba = true;              // run local bundle adjustment after each keyframe
-  int ba_iterations = 10;            // Levenberg-Marquardt iterations
-  int max_local_keyframes = 20;      // optimised keyframes: current + best covisibles
-  int max_fixed_keyframes = 40;      // keyframes observing local points, kept fixed
-  bool fuse = true;                  // SearchInNeighbors
-  int fuse_neighbours = 10;          // first-order neighbours to fuse with
-  bool cull_keyframes = true;        // KeyFrameCulling
-  double redundancy = 0.9;           // cull if this fraction of points is seen by >= 3 others
-  double min_found_ratio = 0.25;     // landmark culling: found / visible
+  bool local_ba = true;           // run local bundle adjustment after each keyframe
+  int ba_iterations = 10;         // Levenberg-Marquardt iterations
+  int max_local_keyframes = 20;   // optimised keyframes: current + best covisibles
+  int max_fixed_keyframes = 40;   // keyframes observing local points, kept fixed
+  bool fuse = true;               // SearchInNeighbors
+  int fuse_neighbours = 10;       // first-order neighbours to fuse with
+  bool cull_keyframes = true;     // KeyFrameCulling
+  double redundancy = 0.9;        // cull if this fraction of points is seen by >= 3 others
+  double min_found_ratio = 0.25;  // landmark culling: found / visible
   // CreateNewMapPoints: keypoints without a landmark and without close depth (none, or beyond
   // ThDepth) are matched with those of the best covisible keyframes and triangulated.
   bool triangulate = true;

@@ -60,7 +60,8 @@ bool WithinGate(const PinholeCamera& camera, const ScaleInfo& scale, const KeyFr
 
 }  // namespace
 
-void LocalMapper::TriangulateNewLandmarks(Map& map, KeyFrameId current, LocalMappingSummary* summary) {
+void LocalMapper::TriangulateNewLandmarks(Map& map, KeyFrameId current,
+                                          LocalMappingSummary* summary) {
   const ScaleInfo& scale = map.scale();
   const double close_depth = camera_.CloseDepthThreshold();
   const double ratio_factor = 1.5 * (scale.scale_factors.size() > 1 ? scale.scale_factors[1] : 1.2);
@@ -83,8 +84,7 @@ void LocalMapper::TriangulateNewLandmarks(Map& map, KeyFrameId current, LocalMap
     for (const cv::DMatch& m : MatchBruteForce(kp1, d1, kp2, d2, match)) {
       const size_t i1 = static_cast<size_t>(c1[static_cast<size_t>(m.queryIdx)]);
       const size_t i2 = static_cast<size_t>(c2[static_cast<size_t>(m.trainIdx)]);
-      if (map.keyframe(current).landmarks[i1] != kNoLandmark)
-        continue;  // taken by an earlier pair
+      if (map.keyframe(current).landmarks[i1] != kNoLandmark) continue;  // taken by an earlier pair
       if (map.keyframe(other).landmarks[i2] != kNoLandmark) continue;
       const Eigen::Vector2d xn1 = PixelToNormalized(camera_, f1.undist[i1]);
       const Eigen::Vector2d xn2 = PixelToNormalized(camera_, f2.undist[i2]);

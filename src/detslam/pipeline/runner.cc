@@ -5,9 +5,9 @@
 #include <algorithm>
 #include <chrono>
 #include <filesystem>
+#include <functional>
 #include <nlohmann/json.hpp>
 #include <numeric>
-#include <functional>
 #include <thread>
 
 #include "detslam/core/atomic_file.h"
@@ -19,8 +19,8 @@ namespace detslam {
 namespace {
 
 nlohmann::json StatsJson(const ErrorStats& s) {
-  return {{"count", s.count}, {"median_ms", s.median}, {"mean_ms", s.mean}, {"std_ms", s.std},
-          {"min_ms", s.min}, {"max_ms", s.max}};
+  return {{"count", s.count}, {"median_ms", s.median}, {"mean_ms", s.mean},
+          {"std_ms", s.std},  {"min_ms", s.min},       {"max_ms", s.max}};
 }
 
 void WriteOutputs(const RgbdDataset& dataset, const Settings& settings, const RunOptions& options,
@@ -30,7 +30,8 @@ void WriteOutputs(const RgbdDataset& dataset, const Settings& settings, const Ru
   const std::string header = "detslam trajectory (world_from_camera) of " + dataset.dir() +
                              "\nsettings: " + settings.source;
   WriteTumTrajectory((out / "trajectory.txt").string(), slam.FrameTrajectory(), header);
-  WriteTumTrajectory((out / "keyframes.txt").string(), slam.KeyFrameTrajectory(), "detslam keyframes of " + dataset.dir());
+  WriteTumTrajectory((out / "keyframes.txt").string(), slam.KeyFrameTrajectory(),
+                     "detslam keyframes of " + dataset.dir());
   std::vector<Eigen::Vector3d> points;
   for (const auto& [id, lm] : slam.ReadMap()->landmarks()) {
     (void)id;
@@ -40,13 +41,20 @@ void WriteOutputs(const RgbdDataset& dataset, const Settings& settings, const Ru
   nlohmann::json j;
   j["dataset"] = dataset.dir();
   j["settings"] = settings.source;
-  j["mode"] = options.threaded ? (options.mapping_thread ? "threaded (mapping thread)" : "threaded") : "sequential";
-  j["camera"] = {{"fx", settings.camera.fx}, {"fy", settings.camera.fy}, {"cx", settings.camera.cx},
-                 {"cy", settings.camera.cy}, {"depth_map_factor", settings.camera.depth_map_factor},
-                 {"bf", settings.camera.bf}, {"th_depth", settings.camera.th_depth},
+  j["mode"] = options.threaded ? (options.mapping_thread ? "threaded (mapping thread)" : "threaded")
+                               : "sequential";
+  j["camera"] = {{"fx", settings.camera.fx},
+                 {"fy", settings.camera.fy},
+                 {"cx", settings.camera.cx},
+                 {"cy", settings.camera.cy},
+                 {"depth_map_factor", settings.camera.depth_map_factor},
+                 {"bf", settings.camera.bf},
+                 {"th_depth", settings.camera.th_depth},
                  {"disparity_sigma", settings.camera.disparity_sigma}};
-  j["orb"] = {{"num_features", options.slam.orb.num_features}, {"scale_factor", options.slam.orb.scale_factor},
-              {"num_levels", options.slam.orb.num_levels}, {"ini_th_fast", options.slam.orb.ini_th_fast},
+  j["orb"] = {{"num_features", options.slam.orb.num_features},
+              {"scale_factor", options.slam.orb.scale_factor},
+              {"num_levels", options.slam.orb.num_levels},
+              {"ini_th_fast", options.slam.orb.ini_th_fast},
               {"min_th_fast", options.slam.orb.min_th_fast}};
   j["seed"] = options.slam.tracker.seed;
   j["frames"] = summary.frames;
@@ -59,25 +67,41 @@ void WriteOutputs(const RgbdDataset& dataset, const Settings& settings, const Ru
   j["wall_s"] = summary.wall_s;
   j["segmenter"] = summary.segmenter.empty() ? "none" : summary.segmenter;
   const DetSlamOptions& dyn = options.slam.dynamic;
-  j["dynamic_filter"] = {{"classes", dyn.filter.dynamic_classes}, {"alpha", dyn.filter.alpha},
-                         {"depth_step", dyn.filter.depth_step}, {"mask_dilation_px", dyn.filter.mask_dilation_px},
-                         {"premask", dyn.premask}, {"memory_frames", dyn.memory_frames},
-                         {"geometric_check", dyn.geometric.enabled}, {"segment_every", dyn.segment_every}};
-  j["timings"] = {{"segmentation", StatsJson(summary.segmentation)}, {"extraction", StatsJson(summary.extraction)}, {"tracking", StatsJson(summary.tracking)},
-                  {"local_mapping_per_keyframe", StatsJson(summary.mapping)}, {"total_per_frame", StatsJson(summary.total)}};
+  j["dynamic_filter"] = {{"classes", dyn.filter.dynamic_classes},
+                         {"alpha", dyn.filter.alpha},
+                         {"depth_step", dyn.filter.depth_step},
+                         {"mask_dilation_px", dyn.filter.mask_dilation_px},
+                         {"premask", dyn.premask},
+                         {"memory_frames", dyn.memory_frames},
+                         {"geometric_check", dyn.geometric.enabled},
+                         {"segment_every", dyn.segment_every}};
+  j["timings"] = {{"segmentation", StatsJson(summary.segmentation)},
+                  {"extraction", StatsJson(summary.extraction)},
+                  {"tracking", StatsJson(summary.tracking)},
+                  {"local_mapping_per_keyframe", StatsJson(summary.mapping)},
+                  {"total_per_frame", StatsJson(summary.total)}};
   nlohmann::json per_frame = nlohmann::json::array();
   for (const FrameReport& r : summary.reports) {
-    per_frame.push_back({{"index", r.index}, {"stamp", r.stamp.Seconds()}, {"state", ToString(r.tracking.state)},
-                         {"tracked", r.tracking.pose_valid}, {"method", r.tracking.method},
-                         {"inliers", r.tracking.num_inliers}, {"keyframe", r.keyframe}, {"loop_closed", r.loop_closed},
-                         {"keypoints", r.num_keypoints}, {"dynamic_instances", r.dynamic_instances},
-                         {"rejected_keypoints", r.rejected_keypoints}, {"geometric_rejected", r.tracking.geometric_rejected},
+    per_frame.push_back({{"index", r.index},
+                         {"stamp", r.stamp.Seconds()},
+                         {"state", ToString(r.tracking.state)},
+                         {"tracked", r.tracking.pose_valid},
+                         {"method", r.tracking.method},
+                         {"inliers", r.tracking.num_inliers},
+                         {"keyframe", r.keyframe},
+                         {"loop_closed", r.loop_closed},
+                         {"keypoints", r.num_keypoints},
+                         {"dynamic_instances", r.dynamic_instances},
+                         {"rejected_keypoints", r.rejected_keypoints},
+                         {"geometric_rejected", r.tracking.geometric_rejected},
                          {"segmentation_ms", r.segmentation_ms},
                          {"extraction_ms", r.timings.extraction_ms},
-                         {"tracking_ms", r.timings.tracking_ms}, {"mapping_ms", r.timings.mapping_ms}});
+                         {"tracking_ms", r.timings.tracking_ms},
+                         {"mapping_ms", r.timings.mapping_ms}});
   }
   j["per_frame"] = per_frame;
-  WriteFileAtomically((out / "run.json").string(), [&](std::ostream& os) { os << j.dump(1) << "\n"; });
+  WriteFileAtomically((out / "run.json").string(),
+                      [&](std::ostream& os) { os << j.dump(1) << "\n"; });
 }
 
 }  // namespace
@@ -90,25 +114,32 @@ SlamOptions SlamOptionsFromSettings(const Settings& settings, uint64_t seed) {
   o.orb.ini_th_fast = settings.orb.ini_th_fast;
   o.orb.min_th_fast = settings.orb.min_th_fast;
   o.tracker.seed = seed;
-  o.tracker.max_frames_between_keyframes = std::max(1, static_cast<int>(std::lround(settings.camera.fps)));
-  o.tracker.keyframe_far_points = settings.GetInt("Tracking.KeyFrameFarPoints", o.tracker.keyframe_far_points);
+  o.tracker.max_frames_between_keyframes =
+      std::max(1, static_cast<int>(std::lround(settings.camera.fps)));
+  o.tracker.keyframe_far_points =
+      settings.GetInt("Tracking.KeyFrameFarPoints", o.tracker.keyframe_far_points);
   o.mapper.local_ba = settings.GetBool("LocalMapping.BundleAdjustment", o.mapper.local_ba);
-  o.mapper.max_local_keyframes = settings.GetInt("LocalMapping.MaxLocalKeyFrames", o.mapper.max_local_keyframes);
+  o.mapper.max_local_keyframes =
+      settings.GetInt("LocalMapping.MaxLocalKeyFrames", o.mapper.max_local_keyframes);
   o.mapper.triangulate = settings.GetBool("LocalMapping.Triangulate", o.mapper.triangulate);
   o.loop.enabled = settings.GetBool("LoopClosing.Enabled", o.loop.enabled);
-  o.loop.candidate_radius_m = settings.GetDouble("LoopClosing.CandidateRadius", o.loop.candidate_radius_m);
-  o.loop.global_ba_iterations = settings.GetInt("LoopClosing.GlobalBAIterations", o.loop.global_ba_iterations);
+  o.loop.candidate_radius_m =
+      settings.GetDouble("LoopClosing.CandidateRadius", o.loop.candidate_radius_m);
+  o.loop.global_ba_iterations =
+      settings.GetInt("LoopClosing.GlobalBAIterations", o.loop.global_ba_iterations);
   DetSlamOptions& d = o.dynamic;
   d.filter.alpha = settings.GetDouble("Dynamic.Alpha", d.filter.alpha);
   d.filter.depth_step = settings.GetBool("Dynamic.DepthStep", d.filter.depth_step);
   d.filter.mask_dilation_px = settings.GetInt("Dynamic.MaskDilation", d.filter.mask_dilation_px);
-  d.filter.min_score = static_cast<float>(settings.GetDouble("Dynamic.MinScore", d.filter.min_score));
+  d.filter.min_score =
+      static_cast<float>(settings.GetDouble("Dynamic.MinScore", d.filter.min_score));
   d.premask = settings.GetBool("Dynamic.PreMask", d.premask);
   d.memory_frames = settings.GetInt("Dynamic.MemoryFrames", d.memory_frames);
   d.segment_every = settings.GetInt("Segmentation.EveryK", d.segment_every);
   d.geometric.enabled = settings.GetBool("Dynamic.GeometricCheck", d.geometric.enabled);
   d.geometric.threshold.k = settings.GetDouble("Dynamic.GeometricK", d.geometric.threshold.k);
-  d.geometric.threshold.min_threshold = settings.GetDouble("Dynamic.GeometricMinResidual", d.geometric.threshold.min_threshold);
+  d.geometric.threshold.min_threshold =
+      settings.GetDouble("Dynamic.GeometricMinResidual", d.geometric.threshold.min_threshold);
   const std::string classes = settings.GetString("Dynamic.Classes", "");
   if (!classes.empty()) {
     o.dynamic.filter.dynamic_classes.clear();
@@ -139,7 +170,8 @@ class RunRecorder {
     if (r.segmentation_ms > 0) seg_.push_back(r.segmentation_ms);
     ext_.push_back(r.timings.extraction_ms);
     trk_.push_back(r.timings.tracking_ms);
-    total_ms_.push_back(r.segmentation_ms + r.timings.extraction_ms + r.timings.tracking_ms + r.timings.mapping_ms);
+    total_ms_.push_back(r.segmentation_ms + r.timings.extraction_ms + r.timings.tracking_ms +
+                        r.timings.mapping_ms);
     summary_.reports.push_back(r);
     if (progress_) progress_(summary_.frames, total_, r);
   }
@@ -159,7 +191,8 @@ class RunRecorder {
     summary_.tracking = ComputeErrorStats(trk_);
     summary_.mapping = ComputeErrorStats(slam.mapping_times_ms());
     summary_.total = ComputeErrorStats(total_ms_);
-    summary_.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    summary_.wall_s =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     WriteOutputs(dataset, settings, options, slam, summary_);
     return summary_;
   }
@@ -206,10 +239,12 @@ LoadedFrame LoadAndSegment(const RgbdDataset& dataset, const Settings& settings,
   return f;
 }
 
-Frame Extract(const SlamSystem& slam, const RgbdDataset& dataset, const LoadedFrame& f, FrameReport* report) {
+Frame Extract(const SlamSystem& slam, const RgbdDataset& dataset, const LoadedFrame& f,
+              FrameReport* report) {
   report->segmentation_ms = f.segmentation_ms;
-  return slam.ExtractFrame(f.index, dataset.frame(static_cast<size_t>(f.index)).rgb_stamp, f.images.gray,
-                           f.images.depth_m, cv::Mat(), report, f.segmented ? &f.instances : nullptr);
+  return slam.ExtractFrame(f.index, dataset.frame(static_cast<size_t>(f.index)).rgb_stamp,
+                           f.images.gray, f.images.depth_m, cv::Mat(), report,
+                           f.segmented ? &f.instances : nullptr);
 }
 
 }  // namespace
@@ -251,18 +286,24 @@ RunSummary RunThreaded(const RgbdDataset& dataset, const Settings& settings,
     extracted.Close();
     keyframes.Close();
   });
-  stages.Start("loading", [&] {
-    for (size_t i = 0; i < n; ++i) {
-      if (!loaded.Push(LoadAndSegment(dataset, settings, i, &slam))) break;
-    }
-  }, [&] { loaded.Close(); });
-  stages.Start("extraction", [&] {
-    while (std::optional<LoadedFrame> f = loaded.Pop()) {
-      Extracted e;
-      e.frame = Extract(slam, dataset, *f, &e.report);
-      if (!extracted.Push(std::move(e))) break;
-    }
-  }, [&] { extracted.Close(); });
+  stages.Start(
+      "loading",
+      [&] {
+        for (size_t i = 0; i < n; ++i) {
+          if (!loaded.Push(LoadAndSegment(dataset, settings, i, &slam))) break;
+        }
+      },
+      [&] { loaded.Close(); });
+  stages.Start(
+      "extraction",
+      [&] {
+        while (std::optional<LoadedFrame> f = loaded.Pop()) {
+          Extracted e;
+          e.frame = Extract(slam, dataset, *f, &e.report);
+          if (!extracted.Push(std::move(e))) break;
+        }
+      },
+      [&] { extracted.Close(); });
   if (options.mapping_thread) {
     stages.Start("local mapping", [&] {
       while (std::optional<KeyFrameId> kf = keyframes.Pop()) {
@@ -271,19 +312,22 @@ RunSummary RunThreaded(const RgbdDataset& dataset, const Settings& settings,
       }
     });
   }
-  stages.RunHere("tracking", [&] {
-    while (std::optional<Extracted> e = extracted.Pop()) {
-      const KeyFrameId kf = slam.TrackFrame(std::move(e->frame), &e->report);
-      if (kf != kNoKeyFrame) {
-        if (!options.mapping_thread) {
-          slam.MapKeyFrame(kf, &e->report);
-        } else if (!keyframes.Push(kf)) {
-          break;  // the mapping stage failed
+  stages.RunHere(
+      "tracking",
+      [&] {
+        while (std::optional<Extracted> e = extracted.Pop()) {
+          const KeyFrameId kf = slam.TrackFrame(std::move(e->frame), &e->report);
+          if (kf != kNoKeyFrame) {
+            if (!options.mapping_thread) {
+              slam.MapKeyFrame(kf, &e->report);
+            } else if (!keyframes.Push(kf)) {
+              break;  // the mapping stage failed
+            }
+          }
+          recorder.Add(e->report);
         }
-      }
-      recorder.Add(e->report);
-    }
-  }, [&] { keyframes.Close(); });
+      },
+      [&] { keyframes.Close(); });
   stages.Join();
   return recorder.Finish(dataset, settings, options, slam, start, segmenter);
 }

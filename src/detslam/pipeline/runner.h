@@ -27,7 +27,6 @@ struct RunOptions {
 // SlamOptions from settings (ORBextractor.* and any detslam keys), with `seed` for RANSAC.
 SlamOptions SlamOptionsFromSettings(const Settings& settings, uint64_t seed);
 
-
 struct RunSummary {
   size_t frames = 0;
   size_t tracked = 0;
@@ -61,10 +60,10 @@ RunSummary RunThreaded(const RgbdDataset& dataset, const Settings& settings,
                        Segmenter* segmenter = nullptr);
 
 // RunThreaded if options.threaded, else RunSequential.
-// With a segmenter, every frame is segmented and the Det-SLAM filter rejects keypoints on
-// dynamic objects (in threaded mode segmentation runs in its own thread).
+// With a segmenter, the Det-SLAM stage (options.slam.dynamic) segments every
+// `segment_every`-th frame (masks follow the optical flow in between) and rejects keypoints on
+// dynamic objects; in threaded mode segmentation runs in the loading thread.
 RunSummary Run(const RgbdDataset& dataset, const Settings& settings, const RunOptions& options,
                const ProgressFn& progress = nullptr, Segmenter* segmenter = nullptr);
-
 
 }  // namespace detslam

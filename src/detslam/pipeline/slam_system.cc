@@ -18,7 +18,8 @@ double MsSince(std::chrono::steady_clock::time_point t0) {
 
 bool SlamOptions::Check(std::string* error) const {
   std::string e1, e2, e3, e4, e5;
-  const bool ok = orb.Check(&e1) & tracker.Check(&e2) & mapper.Check(&e3) & dynamic.Check(&e4) & loop.Check(&e5);
+  const bool ok = orb.Check(&e1) & tracker.Check(&e2) & mapper.Check(&e3) & dynamic.Check(&e4) &
+                  loop.Check(&e5);
   if (error) *error = e1 + e2 + e3 + e4 + e5;
   return ok;
 }
@@ -97,7 +98,8 @@ Frame SlamSystem::ExtractFrame(int64_t index, Timestamp stamp, const cv::Mat& gr
   std::vector<float> kept_depth;
   std::vector<KeypointLabel> rejected_labels;
   cv::Mat kept_desc;
-  if (std::all_of(all.labels.begin(), all.labels.end(), [](KeypointLabel l) { return l == KeypointLabel::kStatic; })) {
+  if (std::all_of(all.labels.begin(), all.labels.end(),
+                  [](KeypointLabel l) { return l == KeypointLabel::kStatic; })) {
     kept = std::move(all.keypoints);
     kept_depth = std::move(all.depth);
     kept_desc = all.descriptors;
@@ -135,19 +137,24 @@ KeyFrameId SlamSystem::TrackFrame(Frame frame, FrameReport* report) {
   const size_t kfs_before = map.NumKeyFrames();
   report->tracking = tracker_.Track(map, &frame);
   KeyFrameId new_kf = kNoKeyFrame;
-  if (report->tracking.pose_valid && report->tracking.need_keyframe) new_kf = tracker_.CreateKeyFrame(map, &frame);
-  if (map.NumKeyFrames() > kfs_before && new_kf == kNoKeyFrame) new_kf = tracker_.reference_keyframe();
+  if (report->tracking.pose_valid && report->tracking.need_keyframe)
+    new_kf = tracker_.CreateKeyFrame(map, &frame);
+  if (map.NumKeyFrames() > kfs_before && new_kf == kNoKeyFrame)
+    new_kf = tracker_.reference_keyframe();
   report->timings.tracking_ms = MsSince(t0);
 
   if (report->tracking.pose_valid) {
-    const KeyFrameId ref = frame.reference_keyframe != kNoKeyFrame ? frame.reference_keyframe : tracker_.reference_keyframe();
-    tracked_.push_back({frame.stamp, ref, *frame.cam_from_world * map.keyframe(ref).cam_from_world.Inverse()});
+    const KeyFrameId ref = frame.reference_keyframe != kNoKeyFrame ? frame.reference_keyframe
+                                                                   : tracker_.reference_keyframe();
+    tracked_.push_back(
+        {frame.stamp, ref, *frame.cam_from_world * map.keyframe(ref).cam_from_world.Inverse()});
   }
   report->keyframe = new_kf != kNoKeyFrame;
   return new_kf;
 }
 
-Rigid3d SlamSystem::ReferenceWorldFromCam(const Map& map, KeyFrameId id, const Rigid3d& cam_from_ref) const {
+Rigid3d SlamSystem::ReferenceWorldFromCam(const Map& map, KeyFrameId id,
+                                          const Rigid3d& cam_from_ref) const {
   // Walk up through erased keyframes to one that still exists.
   Rigid3d cam_from_kf = cam_from_ref;
   KeyFrameId kf = id;
@@ -164,14 +171,16 @@ Trajectory SlamSystem::FrameTrajectory() const {
   const MapStore::ReadAccess map = store_.Read();
   Trajectory out;
   out.reserve(tracked_.size());
-  for (const TrackedFrame& t : tracked_) out.push_back({t.stamp, ReferenceWorldFromCam(*map, t.reference, t.cam_from_ref)});
+  for (const TrackedFrame& t : tracked_)
+    out.push_back({t.stamp, ReferenceWorldFromCam(*map, t.reference, t.cam_from_ref)});
   return out;
 }
 
 Trajectory SlamSystem::KeyFrameTrajectory() const {
   const MapStore::ReadAccess map = store_.Read();
   Trajectory out;
-  for (const auto& [id, kf] : map->keyframes()) out.push_back({kf.stamp, kf.cam_from_world.Inverse()});
+  for (const auto& [id, kf] : map->keyframes())
+    out.push_back({kf.stamp, kf.cam_from_world.Inverse()});
   return out;
 }
 

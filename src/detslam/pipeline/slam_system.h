@@ -23,8 +23,8 @@ struct SlamOptions {
   OrbOptions orb;
   TrackerOptions tracker;
   LocalMapperOptions mapper;
-  LoopClosingOptions loop;        // loop closing after local mapping of each keyframe
-  DetSlamOptions dynamic;         // the Det-SLAM stage (segmentation, filter, geometric check)
+  LoopClosingOptions loop;  // loop closing after local mapping of each keyframe
+  DetSlamOptions dynamic;   // the Det-SLAM stage (segmentation, filter, geometric check)
   bool Check(std::string* error) const;
 };
 
@@ -35,13 +35,13 @@ struct FrameTimings {
 
 struct FrameReport {
   int64_t index = 0;
-  int dynamic_instances = 0;  // dynamic instances the filter used
-  int rejected_keypoints = 0; // keypoints rejected by the dynamic filter (after extraction)
-  double segmentation_ms = 0; // time of the segmenter for this frame
+  int dynamic_instances = 0;   // dynamic instances the filter used
+  int rejected_keypoints = 0;  // keypoints rejected by the dynamic filter (after extraction)
+  double segmentation_ms = 0;  // time of the segmenter for this frame
   Timestamp stamp;
   TrackingResult tracking;
   bool keyframe = false;
-  bool loop_closed = false;   // this frame's keyframe closed a loop (mapping in the tracking thread)
+  bool loop_closed = false;  // this frame's keyframe closed a loop (mapping in the tracking thread)
   int num_keypoints = 0;
   FrameTimings timings;
 };

@@ -14,9 +14,12 @@ TEST(StageThreads, AllStagesRunAndJoinReturns) {
   BoundedQueue<int> q(2);
   StageThreads stages([&] { q.Close(); });
   std::atomic<int> sum{0};
-  stages.Start("producer", [&] {
-    for (int i = 1; i <= 100; ++i) q.Push(i);
-  }, [&] { q.Close(); });
+  stages.Start(
+      "producer",
+      [&] {
+        for (int i = 1; i <= 100; ++i) q.Push(i);
+      },
+      [&] { q.Close(); });
   stages.RunHere("consumer", [&] {
     while (std::optional<int> v = q.Pop()) sum += *v;
   });

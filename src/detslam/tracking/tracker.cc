@@ -28,10 +28,14 @@ void Tracker::FrameScratch::ClearTemporaryMatches() {
 
 const char* ToString(TrackingState state) {
   switch (state) {
-    case TrackingState::kNotInitialized: return "not_initialized";
-    case TrackingState::kOk: return "ok";
-    case TrackingState::kRecentlyLost: return "recently_lost";
-    case TrackingState::kLost: return "lost";
+    case TrackingState::kNotInitialized:
+      return "not_initialized";
+    case TrackingState::kOk:
+      return "ok";
+    case TrackingState::kRecentlyLost:
+      return "recently_lost";
+    case TrackingState::kLost:
+      return "lost";
   }
   return "?";
 }
@@ -66,7 +70,8 @@ void Tracker::OnLoopClosed(const Map& map, const std::map<KeyFrameId, Rigid3d>& 
   KeyFrameId ref = last_frame_->reference_keyframe;
   if (!map.HasKeyFrame(ref) || !old_poses.count(ref)) ref = reference_kf_;
   if (!map.HasKeyFrame(ref) || !old_poses.count(ref)) return;
-  last_frame_->cam_from_world = *last_frame_->cam_from_world * old_poses.at(ref).Inverse() * map.keyframe(ref).cam_from_world;
+  last_frame_->cam_from_world =
+      *last_frame_->cam_from_world * old_poses.at(ref).Inverse() * map.keyframe(ref).cam_from_world;
   BuildTemporaryPoints(map);
 }
 
@@ -172,7 +177,8 @@ void Tracker::BuildTemporaryPoints(const Map& map) {
   int created = 0;
   for (const auto& [d, i] : by_depth) {
     if (!last_frame_->labels.empty() && last_frame_->labels[i] != KeypointLabel::kStatic) continue;
-    const bool has_landmark = last_frame_->landmarks[i] != kNoLandmark && map.HasLandmark(last_frame_->landmarks[i]);
+    const bool has_landmark =
+        last_frame_->landmarks[i] != kNoLandmark && map.HasLandmark(last_frame_->landmarks[i]);
     if (!has_landmark) {
       temporary_points_[i] = world_from_cam * camera_.Unproject(f.undist[i], d);
       ++created;

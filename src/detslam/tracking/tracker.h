@@ -21,32 +21,32 @@ enum class TrackingState { kNotInitialized, kOk, kRecentlyLost, kLost };
 const char* ToString(TrackingState state);
 
 struct TrackerOptions {
-  int min_init_keypoints = 500;        // keypoints with depth needed to initialise
-  double motion_window = 7.0;          // projection window, motion model (RGB-D: 7 px at level 0)
-  double local_map_window = 3.0;       // projection window for local map points
-  int min_motion_matches = 20;         // else retry with twice the window
-  int min_pose_inliers = 10;           // motion-model / reference-keyframe success
-  int min_local_map_inliers = 30;      // TrackLocalMap success (50 right after relocalisation)
-  int max_local_keyframes = 80;        // local map size
-  int temporary_points_min = 100;      // frame-to-frame points from the last frame's depth
-  int keyframe_far_points = 300;       // landmarks from depth per keyframe beyond ThDepth (see docs)
-  double recently_lost_seconds = 3.0;  // then LOST
+  int min_init_keypoints = 500;    // keypoints with depth needed to initialise
+  double motion_window = 7.0;      // projection window, motion model (RGB-D: 7 px at level 0)
+  double local_map_window = 3.0;   // projection window for local map points
+  int min_motion_matches = 20;     // else retry with twice the window
+  int min_pose_inliers = 10;       // motion-model / reference-keyframe success
+  int min_local_map_inliers = 30;  // TrackLocalMap success (50 right after relocalisation)
+  int max_local_keyframes = 80;    // local map size
+  int temporary_points_min = 100;  // frame-to-frame points from the last frame's depth
+  int keyframe_far_points = 300;   // landmarks from depth per keyframe beyond ThDepth (see docs)
+  double recently_lost_seconds = 3.0;     // then LOST
   int max_frames_between_keyframes = 30;  // mMaxFrames (= fps)
-  double ref_ratio = 0.75;             // thRefRatio (0.4 with one keyframe)
-  int close_tracked_max = 100;         // bNeedToInsertClose: tracked close < this
-  int close_untracked_min = 70;        //                      and untracked close > this
-  uint64_t seed = 42;                  // relocalisation RANSAC
+  double ref_ratio = 0.75;                // thRefRatio (0.4 with one keyframe)
+  int close_tracked_max = 100;            // bNeedToInsertClose: tracked close < this
+  int close_untracked_min = 70;           //                      and untracked close > this
+  uint64_t seed = 42;                     // relocalisation RANSAC
   bool Check(std::string* error) const;
 };
 
 struct TrackingResult {
   TrackingState state = TrackingState::kNotInitialized;
-  bool pose_valid = false;       // frame has a pose (state OK this frame)
+  bool pose_valid = false;  // frame has a pose (state OK this frame)
   bool need_keyframe = false;
   bool relocalized = false;
-  int num_inliers = 0;           // landmark inliers after local-map tracking
-  int geometric_rejected = 0;    // keypoints the geometric check labelled kGeometric
-  std::string method;            // "init", "motion", "reference", "relocalization", "lost"
+  int num_inliers = 0;         // landmark inliers after local-map tracking
+  int geometric_rejected = 0;  // keypoints the geometric check labelled kGeometric
+  std::string method;          // "init", "motion", "reference", "relocalization", "lost"
 };
 
 // The tracker borrows the map for each call: its callers hold the map store's write access (which
@@ -77,22 +77,27 @@ class Tracker {
 
  private:
   // ORB-SLAM3's fixed tracking thresholds (Tracking.cc, RGB-D), named.
-  static constexpr size_t kLocalMapCovisibles = 10;    // UpdateLocalKeyFrames: best covisibles per K1 keyframe
-  static constexpr int kMinReferenceMatches = 15;      // TrackReferenceKeyFrame: BoW matches needed
-  static constexpr double kReferenceRatio = 0.7;       //   and its matcher's nearest-neighbour ratio
-  static constexpr double kMotionRatio = 0.9;          // TrackWithMotionModel's matcher ratio
-  static constexpr double kLocalMapRatio = 0.8;        // SearchLocalPoints' matcher ratio
-  static constexpr double kRelocLocalMapWindow = 5.0;  // SearchLocalPoints' window right after relocalisation
-  static constexpr size_t kMinRelocalizationMatches = 15; // Relocalization: candidate keyframe matches
-  static constexpr double kRelocalizationRatio = 0.75; //   and its matcher's ratio
-  static constexpr int kMinRelocalizationPnpInliers = 10;  // PnP + pose optimisation inliers to go on
-  static constexpr int kRelocalizationInliers = 50;    // inliers that accept a relocalisation; also
-                                                       // TrackLocalMap's need right after one
-  static constexpr double kRelocalizationWindow = 10;  // projection search widening a relocalisation
+  static constexpr size_t kLocalMapCovisibles =
+      10;  // UpdateLocalKeyFrames: best covisibles per K1 keyframe
+  static constexpr int kMinReferenceMatches = 15;  // TrackReferenceKeyFrame: BoW matches needed
+  static constexpr double kReferenceRatio = 0.7;   //   and its matcher's nearest-neighbour ratio
+  static constexpr double kMotionRatio = 0.9;      // TrackWithMotionModel's matcher ratio
+  static constexpr double kLocalMapRatio = 0.8;    // SearchLocalPoints' matcher ratio
+  static constexpr double kRelocLocalMapWindow =
+      5.0;  // SearchLocalPoints' window right after relocalisation
+  static constexpr size_t kMinRelocalizationMatches =
+      15;  // Relocalization: candidate keyframe matches
+  static constexpr double kRelocalizationRatio = 0.75;  //   and its matcher's ratio
+  static constexpr int kMinRelocalizationPnpInliers =
+      10;                                            // PnP + pose optimisation inliers to go on
+  static constexpr int kRelocalizationInliers = 50;  // inliers that accept a relocalisation; also
+                                                     // TrackLocalMap's need right after one
+  static constexpr double kRelocalizationWindow =
+      10;  // projection search widening a relocalisation
   static constexpr double kRelocalizationProjectionRatio = 0.9;
-  static constexpr int kMinKeyFrameInliers = 15;       // NeedNewKeyFrame c2: at least this many inliers
+  static constexpr int kMinKeyFrameInliers = 15;  // NeedNewKeyFrame c2: at least this many inliers
   static constexpr double kNewKeyFrameRefRatioOneKf = 0.4;  // thRefRatio with one keyframe
-  static constexpr double kNewKeyFrameLowRatio = 0.25;      // c1c: weak tracking against the reference
+  static constexpr double kNewKeyFrameLowRatio = 0.25;  // c1c: weak tracking against the reference
 
   // Per-keypoint state of the frame being tracked, reset once at the start of Track.
   struct FrameScratch {

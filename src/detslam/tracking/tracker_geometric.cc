@@ -1,12 +1,13 @@
-// Tracker: the geometric check for movers the segmenter missed (issue 4).
+// Tracker: the Det-SLAM stage's geometric check for movers the segmenter missed (options:
+// MoverCheckOptions, from DetSlamOptions::geometric).
 //
 // After the frame's pose is optimised against the map, every keypoint that was associated with a
-// map point or a frame-to-frame point (kept as inlier or rejected by the optimiser) has a
-// reprojection residual (u, v and, with depth, the virtual right u), divided by its octave's scale
-// so that residuals of all levels compare. Keypoints far above the robust spread of the others
-// (FlagGeometricOutliers: median + k * 1.4826 * MAD, with a floor) are movers candidates; a
-// candidate counts only with at least `geometric_min_cluster` other candidates within
-// `geometric_radius_px` at the same depth (isolated large residuals are mismatches, not movers).
+// map point or a frame-to-frame point (kept as inlier or rejected by the optimiser) has an image
+// reprojection residual (the pixel distance in u, v; depth does not enter), divided by its
+// octave's scale so that residuals of all levels compare. Keypoints far above the robust spread
+// of the others (FlagGeometricOutliers: median + k * 1.4826 * MAD, with a floor) are mover
+// candidates; a candidate counts only with at least `min_cluster` other candidates within
+// `radius_px` at the same depth (isolated large residuals are mismatches, not movers).
 // Unmatched keypoints next to a confirmed mover at its depth, and keypoints that match the last
 // frame's movers, are labelled too. Labelled keypoints never become landmarks or frame-to-frame
 // points, so a person the detector missed does not enter the map.
@@ -48,7 +49,8 @@ int Tracker::ApplyGeometricCheck(const Map& map, Frame* frame, int* inliers) {
     const Eigen::Vector3d pc = pose * p;
     if (pc.z() <= 0) continue;
     const Eigen::Vector2d uv = camera_.Project(pc);
-    residual[i] = (uv - f.undist[i]).norm() / scale.scale_factors[static_cast<size_t>(f.keypoints[i].octave)];
+    residual[i] =
+        (uv - f.undist[i]).norm() / scale.scale_factors[static_cast<size_t>(f.keypoints[i].octave)];
   }
   std::vector<KeypointLabel> candidate = frame->labels;
   const GeometricCheckResult stats = FlagGeometricOutliers(residual, movers_.threshold, &candidate);
@@ -72,7 +74,8 @@ int Tracker::ApplyGeometricCheck(const Map& map, Frame* frame, int* inliers) {
   //    moved: a residual against that position above the threshold (a keypoint that stayed put
   //    is static after all).
   std::vector<size_t> carried;
-  if (std::isfinite(stats.threshold) && last_frame_ && last_frame_->cam_from_world && !last_frame_->labels.empty()) {
+  if (std::isfinite(stats.threshold) && last_frame_ && last_frame_->cam_from_world &&
+      !last_frame_->labels.empty()) {
     const FrameFeatures& last = *last_frame_->features;
     const Rigid3d world_from_last = last_frame_->cam_from_world->Inverse();
     std::vector<ProjectionCandidate> movers;
@@ -89,12 +92,14 @@ int Tracker::ApplyGeometricCheck(const Map& map, Frame* frame, int* inliers) {
       opt.window = movers_.carry_window_px;
       opt.ratio = 0.9;
       opt.max_distance = kThHigh;
-      const std::vector<int> m = SearchByProjection(camera_, scale, f, pose, movers, TakenMask(*frame), opt);
+      const std::vector<int> m =
+          SearchByProjection(camera_, scale, f, pose, movers, TakenMask(*frame), opt);
       for (size_t c = 0; c < movers.size(); ++c) {
         if (m[c] < 0) continue;
         const size_t kp = static_cast<size_t>(m[c]);
         const Eigen::Vector2d uv = camera_.Project(pose * movers[c].position);
-        const double r = (uv - f.undist[kp]).norm() / scale.scale_factors[static_cast<size_t>(f.keypoints[kp].octave)];
+        const double r = (uv - f.undist[kp]).norm() /
+                         scale.scale_factors[static_cast<size_t>(f.keypoints[kp].octave)];
         if (r > stats.threshold) carried.push_back(kp);
       }
     }
@@ -112,15 +117,19 @@ int Tracker::ApplyGeometricCheck(const Map& map, Frame* frame, int* inliers) {
   for (size_t i : seeds) {
     label(i);
     for (size_t j : f.grid->FeaturesInArea(f.undist[i].x(), f.undist[i].y(), radius)) {
-      if (frame->landmarks[j] == kNoLandmark && SameDepth(f.depth[i], f.depth[j], movers_.depth_ratio)) {
+      if (frame->landmarks[j] == kNoLandmark &&
+          SameDepth(f.depth[i], f.depth[j], movers_.depth_ratio)) {
         label(j);
       }
     }
   }
   const int spread = labelled;
   for (size_t i : carried) label(i);
-  spdlog::debug("frame {}: geometric check: {} residuals, median {:.2f}, threshold {:.2f}, {} candidates, {} seeds, {} with spread, {} carried",
-                frame->index, stats.samples, stats.median, stats.threshold, stats.flagged, seeds.size(), spread, carried.size());
+  spdlog::debug(
+      "frame {}: geometric check: {} residuals, median {:.2f}, threshold {:.2f}, {} candidates, {} "
+      "seeds, {} with spread, {} carried",
+      frame->index, stats.samples, stats.median, stats.threshold, stats.flagged, seeds.size(),
+      spread, carried.size());
 
   // 5. Movers must not hold map associations; re-optimise if an inlier was one.
   bool dropped_inlier = false;

@@ -34,7 +34,8 @@ void Tracker::UpdateLocalMap(const Map& map, const Frame& frame) {
   }
   // K2: the best covisibles of K1, children and parent.
   const size_t k1 = local_keyframes_.size();
-  for (size_t k = 0; k < k1 && static_cast<int>(local_keyframes_.size()) < options_.max_local_keyframes; ++k) {
+  for (size_t k = 0;
+       k < k1 && static_cast<int>(local_keyframes_.size()) < options_.max_local_keyframes; ++k) {
     const KeyFrame& kf = map.keyframe(local_keyframes_[k]);
     std::vector<KeyFrameId> more = map.BestCovisibles(kf.id, kLocalMapCovisibles);
     more.insert(more.end(), kf.children.begin(), kf.children.end());
@@ -82,7 +83,8 @@ bool Tracker::TrackLocalMap(Map& map, Frame* frame, int* inliers) {
   if (frame->index < last_reloc_frame_ + 2) opt.window = kRelocLocalMapWindow;
   opt.ratio = kLocalMapRatio;
   const std::vector<bool> taken = TakenMask(*frame);
-  const std::vector<int> m = SearchByProjection(camera_, map.scale(), *frame->features, pose, candidates, taken, opt);
+  const std::vector<int> m =
+      SearchByProjection(camera_, map.scale(), *frame->features, pose, candidates, taken, opt);
   for (size_t c = 0; c < candidates.size(); ++c) {
     if (m[c] >= 0) frame->landmarks[static_cast<size_t>(m[c])] = candidates[c].landmark;
   }
@@ -92,7 +94,8 @@ bool Tracker::TrackLocalMap(Map& map, Frame* frame, int* inliers) {
     if (frame->landmarks[i] != kNoLandmark) ++map.landmark(frame->landmarks[i]).found;
   }
   const int needed = frame->index < last_reloc_frame_ + options_.max_frames_between_keyframes
-                         ? kRelocalizationInliers : options_.min_local_map_inliers;
+                         ? kRelocalizationInliers
+                         : options_.min_local_map_inliers;
   return *inliers >= needed;
 }
 
@@ -101,9 +104,11 @@ bool Tracker::Relocalize(const Map& map, Frame* frame) {
   // that yields a verified pose wins.
   const FrameFeatures& f = *frame->features;
   std::vector<KeyFrameId> kfs;
-  for (auto it = map.keyframes().rbegin(); it != map.keyframes().rend(); ++it) kfs.push_back(it->first);
+  for (auto it = map.keyframes().rbegin(); it != map.keyframes().rend(); ++it)
+    kfs.push_back(it->first);
   for (KeyFrameId kf_id : kfs) {
-    const std::vector<LandmarkId> matched = MatchKeyFrameLandmarks(map.keyframe(kf_id), f, kRelocalizationRatio, kThLow);
+    const std::vector<LandmarkId> matched =
+        MatchKeyFrameLandmarks(map.keyframe(kf_id), f, kRelocalizationRatio, kThLow);
     std::vector<size_t> kp_index;
     std::vector<Eigen::Vector3d> pts;
     std::vector<Eigen::Vector2d> px;
@@ -140,7 +145,8 @@ bool Tracker::Relocalize(const Map& map, Frame* frame) {
       ProjectionSearchOptions po;
       po.window = kRelocalizationWindow;
       po.ratio = kRelocalizationProjectionRatio;
-      const std::vector<int> m = SearchByProjection(camera_, map.scale(), f, *frame->cam_from_world, cands, taken, po);
+      const std::vector<int> m =
+          SearchByProjection(camera_, map.scale(), f, *frame->cam_from_world, cands, taken, po);
       for (size_t c = 0; c < cands.size(); ++c) {
         if (m[c] >= 0) frame->landmarks[static_cast<size_t>(m[c])] = cands[c].landmark;
       }
@@ -148,7 +154,8 @@ bool Tracker::Relocalize(const Map& map, Frame* frame) {
     }
     if (inliers >= kRelocalizationInliers) {
       reference_kf_ = kf_id;
-      spdlog::info("frame {}: relocalised against keyframe {} ({} inliers)", frame->index, kf_id, inliers);
+      spdlog::info("frame {}: relocalised against keyframe {} ({} inliers)", frame->index, kf_id,
+                   inliers);
       return true;
     }
   }
@@ -162,7 +169,8 @@ bool Tracker::NeedNewKeyFrame(const Map& map, const Frame& frame, int inliers) c
   if (frame.index < last_reloc_frame_ + max_frames && num_kfs > max_frames) return false;
   // ORB-SLAM counts an RGB-D observation twice; in keyframes its 2 (3) observations are 1 (2).
   const int min_obs = num_kfs <= 2 ? 1 : 2;
-  const int ref_matches = map.HasKeyFrame(reference_kf_) ? map.TrackedLandmarks(reference_kf_, min_obs) : 0;
+  const int ref_matches =
+      map.HasKeyFrame(reference_kf_) ? map.TrackedLandmarks(reference_kf_, min_obs) : 0;
   int tracked_close = 0, untracked_close = 0;
   const FrameFeatures& f = *frame.features;
   for (size_t i = 0; i < f.size(); ++i) {
@@ -175,7 +183,8 @@ bool Tracker::NeedNewKeyFrame(const Map& map, const Frame& frame, int inliers) c
       }
     }
   }
-  const bool need_close = tracked_close < options_.close_tracked_max && untracked_close > options_.close_untracked_min;
+  const bool need_close =
+      tracked_close < options_.close_tracked_max && untracked_close > options_.close_untracked_min;
   const double th_ref = num_kfs < 2 ? kNewKeyFrameRefRatioOneKf : options_.ref_ratio;
   const bool c1a = frame.index >= last_keyframe_frame_ + max_frames;
   const bool c1b = true;  // sequential mapping: the local mapper is always idle here
@@ -222,7 +231,8 @@ KeyFrameId Tracker::CreateLandmarksFromDepth(Map& map, Frame* frame, KeyFrameId 
   int created = 0;
   for (const auto& [d, i] : by_depth) {
     if (frame->landmarks[i] == kNoLandmark) {
-      const LandmarkId lm = map.AddLandmark(world_from_cam * camera_.Unproject(f.undist[i], d), kf_id);
+      const LandmarkId lm =
+          map.AddLandmark(world_from_cam * camera_.Unproject(f.undist[i], d), kf_id);
       map.AddObservation(lm, kf_id, i);
       map.UpdateLandmarkGeometry(lm);
       map.UpdateLandmarkDescriptor(lm);
