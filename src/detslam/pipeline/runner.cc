@@ -15,6 +15,7 @@
 #include "detslam/dynamic/mask_propagation.h"
 #include "detslam/io/ply.h"
 #include "detslam/pipeline/bounded_queue.h"
+#include "detslam/pipeline/settings_keys.h"
 
 namespace detslam {
 namespace {
@@ -41,6 +42,7 @@ void WriteOutputs(const RgbdDataset& dataset, const Settings& settings, const Ru
   nlohmann::json j;
   j["dataset"] = dataset.dir();
   j["settings"] = settings.source;
+  j["effective_settings"] = EffectiveSettingsJson(settings, options);
   j["mode"] = options.threaded ? (options.slam.mapping_thread ? "threaded (mapping thread)" : "threaded") : "sequential";
   j["camera"] = {{"fx", settings.camera.fx}, {"fy", settings.camera.fy}, {"cx", settings.camera.cx},
                  {"cy", settings.camera.cy}, {"depth_map_factor", settings.camera.depth_map_factor},
@@ -83,7 +85,7 @@ void WriteOutputs(const RgbdDataset& dataset, const Settings& settings, const Ru
 }  // namespace
 
 SlamOptions SlamOptionsFromSettings(const Settings& settings, uint64_t seed) {
-  SlamOptions o;
+  SlamOptions o = ResolveSettings(settings).run.slam;  // detslam's own keys (settings_keys.cc)
   o.orb.num_features = settings.orb.n_features;
   o.orb.scale_factor = settings.orb.scale_factor;
   o.orb.num_levels = settings.orb.n_levels;
@@ -91,35 +93,6 @@ SlamOptions SlamOptionsFromSettings(const Settings& settings, uint64_t seed) {
   o.orb.min_th_fast = settings.orb.min_th_fast;
   o.tracker.seed = seed;
   o.tracker.max_frames_between_keyframes = std::max(1, static_cast<int>(std::lround(settings.camera.fps)));
-  o.tracker.keyframe_far_points = settings.GetInt("Tracking.KeyFrameFarPoints", o.tracker.keyframe_far_points);
-  o.mapper.local_ba = settings.GetBool("LocalMapping.BundleAdjustment", o.mapper.local_ba);
-  o.mapper.max_local_keyframes = settings.GetInt("LocalMapping.MaxLocalKeyFrames", o.mapper.max_local_keyframes);
-  o.mapper.triangulate = settings.GetBool("LocalMapping.Triangulate", o.mapper.triangulate);
-  o.loop.enabled = settings.GetBool("LoopClosing.Enabled", o.loop.enabled);
-  o.loop.candidate_radius_m = settings.GetDouble("LoopClosing.CandidateRadius", o.loop.candidate_radius_m);
-  o.loop.global_ba_iterations = settings.GetInt("LoopClosing.GlobalBAIterations", o.loop.global_ba_iterations);
-  o.dynamic.alpha = settings.GetDouble("Dynamic.Alpha", o.dynamic.alpha);
-  o.dynamic.depth_step = settings.GetBool("Dynamic.DepthStep", o.dynamic.depth_step);
-  o.dynamic.mask_dilation_px = settings.GetInt("Dynamic.MaskDilation", o.dynamic.mask_dilation_px);
-  o.dynamic.min_score = static_cast<float>(settings.GetDouble("Dynamic.MinScore", o.dynamic.min_score));
-  o.dynamic_premask = settings.GetBool("Dynamic.PreMask", o.dynamic_premask);
-  o.dynamic_memory_frames = settings.GetInt("Dynamic.MemoryFrames", o.dynamic_memory_frames);
-  o.tracker.geometric_check = settings.GetBool("Dynamic.GeometricCheck", o.tracker.geometric_check);
-  o.tracker.geometric.k = settings.GetDouble("Dynamic.GeometricK", o.tracker.geometric.k);
-  o.tracker.geometric.min_threshold = settings.GetDouble("Dynamic.GeometricMinResidual", o.tracker.geometric.min_threshold);
-  const std::string classes = settings.GetString("Dynamic.Classes", "");
-  if (!classes.empty()) {
-    o.dynamic.dynamic_classes.clear();
-    std::string cur;
-    for (char c : classes + ",") {
-      if (c == ',') {
-        if (!cur.empty()) o.dynamic.dynamic_classes.push_back(cur);
-        cur.clear();
-      } else if (c != ' ') {
-        cur.push_back(c);
-      }
-    }
-  }
   return o;
 }
 
