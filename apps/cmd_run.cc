@@ -11,6 +11,7 @@
 #include "detslam/io/dataset.h"
 #include "detslam/io/settings.h"
 #include "detslam/pipeline/runner.h"
+#include "detslam/pipeline/settings_keys.h"
 #include "detslam/segmentation/dnn_segmenter.h"
 #include "detslam/segmentation/segmenter_factory.h"
 
@@ -69,6 +70,7 @@ void Run(const RunArgs& a) {
   const RgbdDataset dataset = RgbdDataset::Open(a.dataset, dopt);
   Settings settings = a.config.empty() ? PresetForDataset(a.dataset) : ReadSettings(a.config);
   ApplySettingOverrides(a.overrides, &settings);
+  const ResolvedSettings resolved = ResolveSettings(settings);  // rejects bad or unknown keys
   RunOptions options;
   options.out_dir = a.out;
   options.max_frames = a.max_frames;
@@ -87,14 +89,14 @@ void Run(const RunArgs& a) {
   std::unique_ptr<Segmenter> segmenter;
   if (spec.empty()) {
     try {
-      segmenter = MakeSegmenter("dnn", a.dataset, settings, models_dir);
+      segmenter = MakeSegmenter("dnn", a.dataset, resolved.segmenter, models_dir);
       spec = "dnn";
     } catch (const InputError& e) {
       std::fprintf(stderr, "note: no dynamic-object segmentation (pass --segmenter dnn|masks:DIR|gt|none): %s\n", e.what());
       spec = "none";
     }
   } else {
-    segmenter = MakeSegmenter(spec, a.dataset, settings, models_dir);
+    segmenter = MakeSegmenter(spec, a.dataset, resolved.segmenter, models_dir);
   }
   std::printf("detslam run (%s, segmenter %s): %zu frames from %s (settings: %s)\n", a.threaded ? "threaded" : "sequential", spec.c_str(), dataset.size(), dataset.dir().c_str(),
               settings.source.c_str());
@@ -139,7 +141,7 @@ void AddRunCommand(CLI::App& app) {
       ->check(CLI::PositiveNumber);
   cmd->add_option("--set", args->overrides,
                   "Override a settings key, KEY=VALUE (repeatable), e.g. --set Dynamic.MaskDilation=10; "
-                  "for Tracking.*, LocalMapping.*, Dynamic.* and Segmentation.* keys");
+                  "the keys: detslam settings --list");
   cmd->add_flag("--threaded", args->threaded,
                 "One thread per stage: loading+segmentation, extraction, tracking, local mapping (real-time use; not bit-reproducible)");
   cmd->add_flag("--inline-mapping", args->inline_mapping,

@@ -10,6 +10,7 @@
 #include "detslam/core/check.h"
 #include "detslam/io/dataset.h"
 #include "detslam/io/settings.h"
+#include "detslam/pipeline/settings_keys.h"
 #include "detslam/segmentation/dnn_segmenter.h"
 #include "detslam/segmentation/mask_dir.h"
 
@@ -32,7 +33,7 @@ void Segment(const SegmentArgs& a) {
   Settings settings = a.config.empty() ? PresetForDataset(a.dataset) : ReadSettings(a.config);
   ApplySettingOverrides(a.overrides, &settings);
   const std::string models = a.models.empty() ? DefaultModelsDir() : a.models;
-  DnnSegmenterOptions options = DnnOptionsFromSettings(settings, models);
+  DnnSegmenterOptions options = DnnOptionsFromSettings(ResolveSettings(settings).segmenter, models);
   if (!a.detector.empty()) {
     options.detector_path = a.detector;
     options.weights_path.clear();

@@ -20,5 +20,6 @@ void AddSynthCommand(CLI::App& app);
 void AddRunCommand(CLI::App& app);
 void AddSegmentCommand(CLI::App& app);
 void AddReportCommand(CLI::App& app);
+void AddSettingsCommand(CLI::App& app);
 
 }  // namespace detslam::app

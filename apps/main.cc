@@ -1,4 +1,4 @@
-// The `detslam` command: subcommands run, eval, synth, segment, report (see --help).
+// The `detslam` command: subcommands run, eval, synth, segment, report, settings (see --help).
 #include <spdlog/spdlog.h>
 
 #include <exception>
@@ -20,6 +20,7 @@ int main(int argc, char** argv) {
   detslam::app::AddSynthCommand(app);
   detslam::app::AddSegmentCommand(app);
   detslam::app::AddReportCommand(app);
+  detslam::app::AddSettingsCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -6,13 +6,16 @@
 
 #include <filesystem>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <sstream>
 
 #include "detslam/core/check.h"
 #include "detslam/eval/evaluate.h"
+#include "detslam/eval/run_log.h"
 #include "detslam/io/dataset.h"
 #include "detslam/io/settings.h"
 #include "detslam/pipeline/runner.h"
+#include "detslam/pipeline/settings_keys.h"
 #include "detslam/segmentation/segmenter_factory.h"
 #include "detslam/synth/writer.h"
 #include "support/shared_data.h"
@@ -46,7 +49,8 @@ SlamRun RunAndEvaluate(const std::string& dataset_dir, const std::string& out_di
   options.threaded = threaded;
   options.slam = SlamOptionsFromSettings(settings, seed);
   options.mapping_thread = mapping_thread;
-  const std::unique_ptr<Segmenter> segmenter = MakeSegmenter(segmenter_spec, dataset_dir, settings, "");
+  const std::unique_ptr<Segmenter> segmenter =
+      MakeSegmenter(segmenter_spec, dataset_dir, ResolveSettings(settings).segmenter, "");
   SlamRun run;
   run.summary = Run(dataset, settings, options, nullptr, segmenter.get());
   run.trajectory_path = (fs::path(out_dir) / "trajectory.txt").string();
@@ -182,6 +186,15 @@ TEST(IntegrationSlamSynthetic, StaticPresetTracksEveryFrameWithinOneCentimetre) 
   const SlamRun run = RunAndEvaluate(seq, TempDir("synth_static_run"), 42);
   EXPECT_EQ(run.summary.tracked, run.summary.frames);
   EXPECT_LE(run.eval.ate.error_m.rmse, 0.01) << "ATE RMSE " << run.eval.ate.error_m.rmse;
+  // run.json records every declared key's effective value, and `detslam report` still reads it.
+  const std::string run_json = (fs::path(run.trajectory_path).parent_path() / "run.json").string();
+  const nlohmann::json j = nlohmann::json::parse(ReadFile(run_json));
+  ASSERT_TRUE(j.contains("effective_settings"));
+  EXPECT_EQ(j["effective_settings"].size(), DeclaredSettings().size());
+  EXPECT_DOUBLE_EQ(j["effective_settings"]["Dynamic.Alpha"].get<double>(), 0.1);
+  EXPECT_EQ(j["effective_settings"]["Dynamic.Classes"], nlohmann::json::array({"person"}));
+  EXPECT_EQ(j["effective_settings"]["Segmentation.EveryK"].get<int>(), 1);
+  EXPECT_EQ(ReadRunLog(run_json).frames, static_cast<int64_t>(run.summary.frames));
 }
 
 }  // namespace

@@ -15,44 +15,10 @@
 
 #include "detslam/core/atomic_file.h"
 #include "detslam/core/check.h"
+#include "detslam/io/setting_spec.h"
 
 namespace detslam {
 namespace {
-
-// ---- text -> typed values (shared by the reader and Settings::Get*) ----
-
-bool ParseDoubleText(const std::string& text, double* out) {
-  if (text.empty()) return false;
-  char* end = nullptr;
-  const double v = std::strtod(text.c_str(), &end);
-  if (end == text.c_str() || *end != '\0' || !std::isfinite(v)) return false;
-  *out = v;
-  return true;
-}
-
-// Integers; a real with an integral value ("640.0") is accepted too.
-bool ParseIntText(const std::string& text, int* out) {
-  double v = 0;
-  if (!ParseDoubleText(text, &v) || v != std::floor(v) || v < std::numeric_limits<int>::min() ||
-      v > std::numeric_limits<int>::max()) {
-    return false;
-  }
-  *out = static_cast<int>(v);
-  return true;
-}
-
-bool ParseBoolText(const std::string& text, bool* out) {
-  std::string t = text;
-  std::transform(t.begin(), t.end(), t.begin(), [](unsigned char c) { return std::tolower(c); });
-  if (t == "1" || t == "true" || t == "yes" || t == "on") {
-    *out = true;
-  } else if (t == "0" || t == "false" || t == "no" || t == "off") {
-    *out = false;
-  } else {
-    return false;
-  }
-  return true;
-}
 
 // ---- reading ----
 
@@ -115,13 +81,13 @@ class Reader {
     return e == nullptr ? fallback : e->text;
   }
 
-  // Scalar keys that no typed accessor consumed.
-  std::map<std::string, std::string> Unused() const {
-    std::map<std::string, std::string> out;
+  // Scalar keys that no typed accessor consumed, into `extra` and `extra_origin` ("FILE:LINE").
+  void MoveUnused(Settings* s) const {
     for (const auto& [key, entry] : entries_) {
-      if (used_.count(key) == 0) out[key] = entry.text;
+      if (used_.count(key) > 0) continue;
+      s->extra[key] = entry.text;
+      s->extra_origin[key] = path_ + ":" + std::to_string(entry.line);
     }
-    return out;
   }
 
  private:
@@ -243,43 +209,6 @@ bool OrbSettings::Check(std::string* error) const {
   return os.str().empty();
 }
 
-double Settings::GetDouble(const std::string& key, double fallback) const {
-  auto it = extra.find(key);
-  if (it == extra.end()) return fallback;
-  double v = 0;
-  if (!ParseDoubleText(it->second, &v)) {
-    throw InputError(source, 0, "key '" + key + "' must be a number, got '" + it->second + "'");
-  }
-  return v;
-}
-
-int Settings::GetInt(const std::string& key, int fallback) const {
-  auto it = extra.find(key);
-  if (it == extra.end()) return fallback;
-  int v = 0;
-  if (!ParseIntText(it->second, &v)) {
-    throw InputError(source, 0, "key '" + key + "' must be an integer, got '" + it->second + "'");
-  }
-  return v;
-}
-
-bool Settings::GetBool(const std::string& key, bool fallback) const {
-  auto it = extra.find(key);
-  if (it == extra.end()) return fallback;
-  bool v = false;
-  if (!ParseBoolText(it->second, &v)) {
-    throw InputError(
-        source, 0,
-        "key '" + key + "' must be a boolean (0/1, true/false), got '" + it->second + "'");
-  }
-  return v;
-}
-
-std::string Settings::GetString(const std::string& key, const std::string& fallback) const {
-  auto it = extra.find(key);
-  return it == extra.end() ? fallback : it->second;
-}
-
 Settings ReadSettings(const std::string& path) {
   Reader r(path, LoadEntries(path));
   Settings s;
@@ -319,7 +248,8 @@ Settings ReadSettings(const std::string& path) {
     c.bf = r.Double("Camera.bf", c.bf);
     c.th_depth = r.Double("ThDepth", c.th_depth);
     c.depth_map_factor = r.Double("DepthMapFactor", c.depth_map_factor);
-    c.disparity_sigma = r.Double("DisparitySigma", c.disparity_sigma);
+    // detslam's own key, in either spelling (its v1.0 name is the one `settings --list` shows).
+    c.disparity_sigma = r.Double("DisparitySigma", r.Double("RGBD.DisparitySigma", c.disparity_sigma));
   }
   OrbSettings& o = s.orb;
   o.n_features = r.Int("ORBextractor.nFeatures", o.n_features);
@@ -327,7 +257,7 @@ Settings ReadSettings(const std::string& path) {
   o.n_levels = r.Int("ORBextractor.nLevels", o.n_levels);
   o.ini_th_fast = r.Int("ORBextractor.iniThFAST", o.ini_th_fast);
   o.min_th_fast = r.Int("ORBextractor.minThFAST", o.min_th_fast);
-  s.extra = r.Unused();
+  r.MoveUnused(&s);
 
   std::string error;
   if (!c.Check(&error)) throw InputError(path, 0, "invalid camera settings: " + error);
@@ -411,6 +341,7 @@ void ApplySettingOverrides(const std::vector<std::string>& overrides, Settings* 
       }
     }
     settings->extra[key] = o.substr(eq + 1);
+    settings->extra_origin[key] = "--set " + o;
   }
   // The source names every override, so run.json records how the run was configured.
   for (const std::string& o : overrides) settings->source += " + --set " + o;

@@ -4,7 +4,8 @@
 //                                    ThDepth, DepthMapFactor
 //   v1.0 (File.version: "1.0"):      Camera1.fx ... Camera1.k3, Camera.width height fps RGB,
 //                                    Stereo.ThDepth, Stereo.b (bf = b * fx), RGBD.DepthMapFactor
-// plus ORBextractor.*. Every other scalar key is kept as text in `extra`. YAML is parsed here
+// plus ORBextractor.*. Every other scalar key is kept as text in `extra` (detslam's own keys are
+// declared, typed and checked in pipeline/settings_keys.h). YAML is parsed here
 // only; algorithms receive the plain structs.
 #pragma once
 
@@ -31,15 +32,10 @@ struct Settings {
   PinholeCamera camera;                      // intrinsics, distortion and depth conventions
   OrbSettings orb;                           // ORB extractor parameters
   std::map<std::string, std::string> extra;  // all other scalar keys, value as text
-  std::string source;                        // file path or "preset <name>"
-
-  // Typed access to `extra`: `fallback` if the key is absent; throws InputError naming `source`
-  // and the key if the value does not have the requested type.
-  double GetDouble(const std::string& key, double fallback) const;
-  int GetInt(const std::string& key, int fallback) const;
-  // Accepts true/false, yes/no, on/off (any case) and 1/0.
-  bool GetBool(const std::string& key, bool fallback) const;
-  std::string GetString(const std::string& key, const std::string& fallback) const;
+  // Where each extra key came from, for error messages: "FILE:LINE" or "--set KEY=VALUE"
+  // (absent: `source`). detslam's own keys are typed and checked by pipeline/settings_keys.h.
+  std::map<std::string, std::string> extra_origin;
+  std::string source;  // file path or "preset <name>"
 };
 
 // Reads a settings file. Throws InputError naming the file (and line / key) if the file is
@@ -62,8 +58,9 @@ Settings PresetByName(const std::string& name);
 Settings PresetForDataset(const std::string& dataset_dir);
 
 // Applies command-line overrides "KEY=VALUE" (`--set`) to the extra keys (Tracking.*,
-// LocalMapping.*, Dynamic.*, Segmentation.*, ...). Throws InputError for a malformed item or a
-// camera/ORB key (those come from the settings file).
+// LocalMapping.*, Dynamic.*, Segmentation.*, ...) and RGBD.DisparitySigma. Throws InputError for
+// a malformed item or a camera/ORB key (those come from the settings file); unknown keys are
+// rejected when the settings are resolved (pipeline/settings_keys.h).
 void ApplySettingOverrides(const std::vector<std::string>& overrides, Settings* settings);
 
 }  // namespace detslam

@@ -14,6 +14,7 @@
 #include "detslam/io/ply.h"
 #include "detslam/pipeline/bounded_queue.h"
 #include "detslam/pipeline/stage_threads.h"
+#include "detslam/pipeline/settings_keys.h"
 
 namespace detslam {
 namespace {
@@ -41,6 +42,7 @@ void WriteOutputs(const RgbdDataset& dataset, const Settings& settings, const Ru
   nlohmann::json j;
   j["dataset"] = dataset.dir();
   j["settings"] = settings.source;
+  j["effective_settings"] = EffectiveSettingsJson(settings, options);
   j["mode"] = options.threaded ? (options.mapping_thread ? "threaded (mapping thread)" : "threaded")
                                : "sequential";
   j["camera"] = {{"fx", settings.camera.fx},
@@ -107,52 +109,14 @@ void WriteOutputs(const RgbdDataset& dataset, const Settings& settings, const Ru
 }  // namespace
 
 SlamOptions SlamOptionsFromSettings(const Settings& settings, uint64_t seed) {
-  SlamOptions o;
+  SlamOptions o = ResolveSettings(settings).run.slam;  // detslam's own keys (settings_keys.cc)
   o.orb.num_features = settings.orb.n_features;
   o.orb.scale_factor = settings.orb.scale_factor;
   o.orb.num_levels = settings.orb.n_levels;
   o.orb.ini_th_fast = settings.orb.ini_th_fast;
   o.orb.min_th_fast = settings.orb.min_th_fast;
   o.tracker.seed = seed;
-  o.tracker.max_frames_between_keyframes =
-      std::max(1, static_cast<int>(std::lround(settings.camera.fps)));
-  o.tracker.keyframe_far_points =
-      settings.GetInt("Tracking.KeyFrameFarPoints", o.tracker.keyframe_far_points);
-  o.mapper.local_ba = settings.GetBool("LocalMapping.BundleAdjustment", o.mapper.local_ba);
-  o.mapper.max_local_keyframes =
-      settings.GetInt("LocalMapping.MaxLocalKeyFrames", o.mapper.max_local_keyframes);
-  o.mapper.triangulate = settings.GetBool("LocalMapping.Triangulate", o.mapper.triangulate);
-  o.loop.enabled = settings.GetBool("LoopClosing.Enabled", o.loop.enabled);
-  o.loop.candidate_radius_m =
-      settings.GetDouble("LoopClosing.CandidateRadius", o.loop.candidate_radius_m);
-  o.loop.global_ba_iterations =
-      settings.GetInt("LoopClosing.GlobalBAIterations", o.loop.global_ba_iterations);
-  DetSlamOptions& d = o.dynamic;
-  d.filter.alpha = settings.GetDouble("Dynamic.Alpha", d.filter.alpha);
-  d.filter.depth_step = settings.GetBool("Dynamic.DepthStep", d.filter.depth_step);
-  d.filter.mask_dilation_px = settings.GetInt("Dynamic.MaskDilation", d.filter.mask_dilation_px);
-  d.filter.min_score =
-      static_cast<float>(settings.GetDouble("Dynamic.MinScore", d.filter.min_score));
-  d.premask = settings.GetBool("Dynamic.PreMask", d.premask);
-  d.memory_frames = settings.GetInt("Dynamic.MemoryFrames", d.memory_frames);
-  d.segment_every = settings.GetInt("Segmentation.EveryK", d.segment_every);
-  d.geometric.enabled = settings.GetBool("Dynamic.GeometricCheck", d.geometric.enabled);
-  d.geometric.threshold.k = settings.GetDouble("Dynamic.GeometricK", d.geometric.threshold.k);
-  d.geometric.threshold.min_threshold =
-      settings.GetDouble("Dynamic.GeometricMinResidual", d.geometric.threshold.min_threshold);
-  const std::string classes = settings.GetString("Dynamic.Classes", "");
-  if (!classes.empty()) {
-    o.dynamic.filter.dynamic_classes.clear();
-    std::string cur;
-    for (char c : classes + ",") {
-      if (c == ',') {
-        if (!cur.empty()) o.dynamic.filter.dynamic_classes.push_back(cur);
-        cur.clear();
-      } else if (c != ' ') {
-        cur.push_back(c);
-      }
-    }
-  }
+  o.tracker.max_frames_between_keyframes = std::max(1, static_cast<int>(std::lround(settings.camera.fps)));
   return o;
 }
 

@@ -24,7 +24,8 @@ struct RunOptions {
   SlamOptions slam;
 };
 
-// SlamOptions from settings (ORBextractor.* and any detslam keys), with `seed` for RANSAC.
+// SlamOptions from settings (ORBextractor.*, Camera.fps and detslam's own keys, see
+// settings_keys.h; throws InputError for a bad or unknown key), with `seed` for RANSAC.
 SlamOptions SlamOptionsFromSettings(const Settings& settings, uint64_t seed);
 
 struct RunSummary {

@@ -14,6 +14,7 @@
 #include "detslam/core/check.h"
 #include "detslam/segmentation/coco_classes.h"
 #include "detslam/segmentation/person_mask.h"
+#include "detslam/segmentation/segmenter_settings.h"
 #include "detslam/segmentation/yolox_decode.h"
 
 #ifndef DETSLAM_DEFAULT_MODELS_DIR
@@ -144,48 +145,30 @@ std::string DefaultModelsDir() {
   return DETSLAM_DEFAULT_MODELS_DIR;
 }
 
-DnnSegmenterOptions DnnOptionsFromSettings(const Settings& s, const std::string& models_dir) {
+DnnSegmenterOptions DnnOptionsFromSettings(const SegmenterSettings& s, const std::string& models_dir) {
   auto resolve = [&](const std::string& p) {
     if (p.empty() || fs::path(p).is_absolute()) return p;
     return (fs::path(models_dir) / p).string();
   };
-  DnnSegmenterOptions o;
-  o.detector_path = resolve(s.GetString("Segmentation.Detector", "yolox_nano/yolox_nano.onnx"));
-  o.weights_path = resolve(s.GetString("Segmentation.Weights", ""));
-  o.names_path = resolve(s.GetString("Segmentation.Names", ""));
-  const std::string mask =
-      s.GetString("Segmentation.PersonMask", "selfie_segmentation/selfie_segmentation.onnx");
-  o.person_mask_model = (mask == "none" || mask.empty()) ? "" : resolve(mask);
-  o.score_threshold =
-      static_cast<float>(s.GetDouble("Segmentation.ScoreThreshold", o.score_threshold));
-  o.nms_threshold = static_cast<float>(s.GetDouble("Segmentation.NmsThreshold", o.nms_threshold));
-  o.box_expand = s.GetDouble("Segmentation.BoxExpand", o.box_expand);
-  o.yolox_input_size = s.GetInt("Segmentation.InputSize", o.yolox_input_size);
-  o.person_mask_min_fill = static_cast<float>(
-      s.GetDouble("Segmentation.PersonMaskMinFill", o.person_mask_min_fill));
+  DnnSegmenterOptions o = s.dnn;
+  o.detector_path = resolve(s.detector);
+  o.weights_path = resolve(s.weights);
+  o.names_path = resolve(s.names);
+  o.person_mask_model = (s.person_mask == "none" || s.person_mask.empty()) ? "" : resolve(s.person_mask);
   // The default second detector is optional: without its files the first one works alone. A
   // second detector named in the settings must exist.
-  const std::string second = s.GetString("Segmentation.SecondDetector", "");
-  if (second.empty()) {
+  if (s.second_detector.empty()) {
     const std::string fallback = resolve(kDefaultSecondDetector);
     if (fs::is_regular_file(fallback)) {
       o.second_detector_path = fallback;
     } else {
       spdlog::warn("second detector {} not found; using the first detector alone", fallback);
     }
-  } else if (second != "none") {
-    o.second_detector_path = resolve(second);
+  } else if (s.second_detector != "none") {
+    o.second_detector_path = resolve(s.second_detector);
   }
-  o.second_weights_path = resolve(s.GetString("Segmentation.SecondWeights", ""));
-  o.second_names_path = resolve(s.GetString("Segmentation.SecondNames", ""));
-  o.second_score_threshold = static_cast<float>(
-      s.GetDouble("Segmentation.SecondScoreThreshold", o.second_score_threshold));
-  o.second_every = s.GetInt("Segmentation.SecondEvery", o.second_every);
-  std::stringstream classes(s.GetString("Segmentation.DynamicClasses", ""));
-  std::string item;
-  while (std::getline(classes, item, ',')) {
-    if (!Trim(item).empty()) o.classes.push_back(Trim(item));
-  }
+  o.second_weights_path = resolve(s.second_weights);
+  o.second_names_path = resolve(s.second_names);
   ResolveModelCompanions(&o);
   return o;
 }

@@ -11,7 +11,6 @@
 #include <string>
 #include <vector>
 
-#include "detslam/io/settings.h"
 #include "detslam/segmentation/box_mask.h"
 #include "detslam/segmentation/segmenter.h"
 
@@ -58,21 +57,13 @@ std::vector<std::string> LookedForModels(const DnnSegmenterOptions& options);
 // Models folder: $DETSLAM_MODELS if set, else the build's default (<shared>/models).
 std::string DefaultModelsDir();
 
-// Options from settings keys (all optional; relative paths resolve against models_dir):
-//   Segmentation.Detector        default <models_dir>/yolox_nano/yolox_nano.onnx
-//   Segmentation.Weights         default: beside the detector (Darknet only)
-//   Segmentation.Names           default: coco.names beside the detector
-//   Segmentation.PersonMask      default <models_dir>/selfie_segmentation/selfie_segmentation.onnx
-//                                ("none" = box masks only)
-//   Segmentation.ScoreThreshold  Segmentation.NmsThreshold  Segmentation.BoxExpand
-//   Segmentation.InputSize       YOLOX input side (default 416)
-//   Segmentation.PersonMaskMinFill  selfie mask fill of the box below which the depth mask is used
-//   Segmentation.SecondDetector  default <models_dir>/yolo_fastest_1.1/yolo-fastest-1.1-xl.cfg
-//                                ("none" = one detector); Segmentation.SecondWeights,
-//                                Segmentation.SecondNames, Segmentation.SecondScoreThreshold,
-//                                Segmentation.SecondEvery (run it on every N-th call, default 2)
-//   Segmentation.DynamicClasses  comma-separated class names to return (default: all)
-DnnSegmenterOptions DnnOptionsFromSettings(const Settings& settings, const std::string& models_dir);
+struct SegmenterSettings;
+
+// Options from the settings (segmenter_settings.h; `detslam settings --list` describes the keys):
+// relative paths resolve against models_dir; weights and names default to the files beside the
+// detector; an empty second detector means yolo-fastest-1.1-xl when its file exists in
+// models_dir, "none" no second detector; person mask "none" means box (depth) masks only.
+DnnSegmenterOptions DnnOptionsFromSettings(const SegmenterSettings& settings, const std::string& models_dir);
 
 // Time spent by the last Segment() call.
 struct DnnTimings {

@@ -10,6 +10,7 @@
 #include "detslam/io/settings.h"
 #include "detslam/segmentation/box_mask.h"
 #include "detslam/segmentation/dnn_segmenter.h"
+#include "detslam/segmentation/segmenter_settings.h"
 #include "support/shared_data.h"
 
 namespace detslam {
@@ -77,7 +78,7 @@ TEST(DataDnnSegmenter, YoloxAndSelfieMasksMatchTheTwoReferencePeople) {
   DETSLAM_REQUIRE_SHARED(kReference);
   const ClipFrame f = LoadClip();
   ASSERT_EQ(f.reference.type(), CV_8UC1);
-  DnnSegmenter seg(DnnOptionsFromSettings(Settings(), SharedPath("models")));
+  DnnSegmenter seg(DnnOptionsFromSettings(SegmenterSettings(), SharedPath("models")));
   const auto all = RunTimed(&seg, f.input, "yolox_nano_selfie");
   const auto people = People(all);
   ASSERT_EQ(people.size(), 2u);

@@ -8,6 +8,7 @@
 
 #include "detslam/core/check.h"
 #include "detslam/segmentation/coco_classes.h"
+#include "detslam/segmentation/segmenter_settings.h"
 
 namespace detslam {
 namespace fs = std::filesystem;
@@ -24,26 +25,15 @@ bool MaskRcnnOptions::Check(std::string* error) const {
   return e.empty();
 }
 
-MaskRcnnOptions MaskRcnnOptionsFromSettings(const Settings& s, const std::string& models_dir) {
-  auto resolve = [&](const std::string& key, const std::string& fallback) {
-    const std::string p = s.GetString(key, fallback);
+MaskRcnnOptions MaskRcnnOptionsFromSettings(const SegmenterSettings& s, const std::string& models_dir) {
+  auto resolve = [&](const std::string& p) {
     if (fs::path(p).is_absolute()) return p;
     return (fs::path(models_dir) / p).string();
   };
-  MaskRcnnOptions o;
-  const std::string dir = "mask_rcnn_inception_v2_coco/";
-  o.graph_path = resolve("Segmentation.MaskRcnnGraph", dir + "frozen_inference_graph.pb");
-  o.config_path =
-      resolve("Segmentation.MaskRcnnConfig", dir + "mask_rcnn_inception_v2_coco_2018_01_28.pbtxt");
-  o.names_path = resolve("Segmentation.MaskRcnnNames", dir + "object_detection_classes_coco.txt");
-  o.score_threshold =
-      static_cast<float>(s.GetDouble("Segmentation.ScoreThreshold", o.score_threshold));
-  std::stringstream classes(s.GetString("Segmentation.DynamicClasses", ""));
-  std::string item;
-  while (std::getline(classes, item, ',')) {
-    const size_t a = item.find_first_not_of(" \t"), b = item.find_last_not_of(" \t");
-    if (a != std::string::npos) o.classes.push_back(item.substr(a, b - a + 1));
-  }
+  MaskRcnnOptions o = s.maskrcnn;
+  o.graph_path = resolve(s.maskrcnn_graph);
+  o.config_path = resolve(s.maskrcnn_config);
+  o.names_path = resolve(s.maskrcnn_names);
   return o;
 }
 

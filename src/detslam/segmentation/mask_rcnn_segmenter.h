@@ -9,7 +9,6 @@
 #include <string>
 #include <vector>
 
-#include "detslam/io/settings.h"
 #include "detslam/segmentation/segmenter.h"
 
 namespace detslam {
@@ -25,12 +24,11 @@ struct MaskRcnnOptions {
   bool Check(std::string* error) const;
 };
 
-// Keys Segmentation.MaskRcnnGraph, Segmentation.MaskRcnnConfig, Segmentation.MaskRcnnNames
-// (relative paths resolve against models_dir; defaults in
-// <models_dir>/mask_rcnn_inception_v2_coco/: frozen_inference_graph.pb,
-// mask_rcnn_inception_v2_coco_2018_01_28.pbtxt, object_detection_classes_coco.txt),
-// Segmentation.ScoreThreshold, Segmentation.DynamicClasses.
-MaskRcnnOptions MaskRcnnOptionsFromSettings(const Settings& settings,
+struct SegmenterSettings;
+
+// Options from the settings (Segmentation.MaskRcnnGraph, .MaskRcnnConfig, .MaskRcnnNames: relative
+// paths resolve against models_dir; Segmentation.ScoreThreshold; Dynamic.Classes).
+MaskRcnnOptions MaskRcnnOptionsFromSettings(const SegmenterSettings& settings,
                                             const std::string& models_dir);
 
 class MaskRcnnSegmenter : public Segmenter {

@@ -10,7 +10,7 @@
 namespace detslam {
 
 std::unique_ptr<Segmenter> MakeSegmenter(const std::string& spec, const std::string& dataset_dir,
-                                         const Settings& settings, const std::string& models_dir) {
+                                         const SegmenterSettings& settings, const std::string& models_dir) {
   if (spec == "none") return nullptr;
   if (spec == "dnn") {
     return std::make_unique<DnnSegmenter>(DnnOptionsFromSettings(settings, models_dir));

@@ -4,8 +4,8 @@
 #include <memory>
 #include <string>
 
-#include "detslam/io/settings.h"
 #include "detslam/segmentation/segmenter.h"
+#include "detslam/segmentation/segmenter_settings.h"
 
 namespace detslam {
 
@@ -17,6 +17,6 @@ namespace detslam {
 //   "none"       nullptr (no segmentation)
 // Throws InputError for an unknown spec, a missing folder or missing models.
 std::unique_ptr<Segmenter> MakeSegmenter(const std::string& spec, const std::string& dataset_dir,
-                                         const Settings& settings, const std::string& models_dir);
+                                         const SegmenterSettings& settings, const std::string& models_dir);
 
 }  // namespace detslam

@@ -27,7 +27,7 @@ TEST(SegmenterFactory, NoneGtMasksAndUnknown) {
   const fs::path dir = fs::temp_directory_path() / "detslam_factory_test";
   fs::remove_all(dir);
   fs::create_directories(dir);
-  Settings settings;
+  SegmenterSettings settings;
   EXPECT_EQ(MakeSegmenter("none", dir.string(), settings, "/nonexistent"), nullptr);
   const std::string gt_error = ErrorOf([&] { MakeSegmenter("gt", dir.string(), settings, ""); });
   EXPECT_NE(gt_error.find("synthetic"), std::string::npos) << gt_error;
@@ -45,7 +45,7 @@ TEST(SegmenterFactory, NoneGtMasksAndUnknown) {
 }
 
 TEST(SegmenterFactory, MissingModelsNameEveryPathLookedAt) {
-  Settings settings;
+  SegmenterSettings settings;
   const std::string e = ErrorOf([&] { MakeSegmenter("dnn", "", settings, "/nonexistent/models"); });
   EXPECT_NE(e.find("/nonexistent/models/yolox_nano/yolox_nano.onnx"), std::string::npos) << e;
   EXPECT_NE(e.find("/nonexistent/models/yolox_nano/coco.names"), std::string::npos) << e;
@@ -62,11 +62,11 @@ TEST(SegmenterFactory, MissingModelsNameEveryPathLookedAt) {
 }
 
 TEST(DnnOptions, FromSettingsResolvesCompanionsAndClasses) {
-  Settings s;
-  s.extra["Segmentation.Detector"] = "yolo_fastest_1.1/yolo-fastest-1.1_body.cfg";
-  s.extra["Segmentation.PersonMask"] = "none";
-  s.extra["Segmentation.ScoreThreshold"] = "0.5";
-  s.extra["Segmentation.DynamicClasses"] = "person, chair,traffic light";
+  SegmenterSettings s;
+  s.detector = "yolo_fastest_1.1/yolo-fastest-1.1_body.cfg";
+  s.person_mask = "none";
+  s.dnn.score_threshold = 0.5f;
+  s.dnn.classes = {"person", "chair", "traffic light"};  // Dynamic.Classes (pipeline/settings_keys.cc)
   const DnnSegmenterOptions o = DnnOptionsFromSettings(s, "/m");
   EXPECT_EQ(o.detector_path, "/m/yolo_fastest_1.1/yolo-fastest-1.1_body.cfg");
   EXPECT_EQ(o.weights_path, "/m/yolo_fastest_1.1/yolo-fastest-1.1_body.weights");
@@ -77,7 +77,7 @@ TEST(DnnOptions, FromSettingsResolvesCompanionsAndClasses) {
   const auto looked = LookedForModels(o);
   EXPECT_EQ(looked.size(), 3u);
 
-  const DnnSegmenterOptions d = DnnOptionsFromSettings(Settings(), "/m");
+  const DnnSegmenterOptions d = DnnOptionsFromSettings(SegmenterSettings(), "/m");
   EXPECT_EQ(d.detector_path, "/m/yolox_nano/yolox_nano.onnx");
   EXPECT_EQ(d.names_path, "/m/yolox_nano/coco.names");
   EXPECT_EQ(d.person_mask_model, "/m/selfie_segmentation/selfie_segmentation.onnx");
@@ -89,13 +89,13 @@ TEST(DnnOptions, FromSettingsResolvesCompanionsAndClasses) {
 
 TEST(DnnOptions, SecondDetectorDefaultIsOptionalAndExplicitOneIsKept) {
   // Default: the second detector is used only where its file exists in the models folder.
-  Settings none_set;
-  none_set.extra["Segmentation.Detector"] = "yolox_nano/yolox_nano.onnx";
+  SegmenterSettings none_set;
+  none_set.detector = "yolox_nano/yolox_nano.onnx";
   EXPECT_TRUE(DnnOptionsFromSettings(none_set, "/no/such/models").second_detector_path.empty());
   const std::string dir = ::testing::TempDir() + "/detslam_second_detector";
   std::filesystem::create_directories(dir + "/yolo_fastest_1.1");
   std::ofstream(dir + "/yolo_fastest_1.1/yolo-fastest-1.1-xl.cfg") << "[net]\n";
-  const DnnSegmenterOptions d = DnnOptionsFromSettings(Settings(), dir);
+  const DnnSegmenterOptions d = DnnOptionsFromSettings(SegmenterSettings(), dir);
   EXPECT_EQ(d.second_detector_path, dir + "/yolo_fastest_1.1/yolo-fastest-1.1-xl.cfg");
   EXPECT_EQ(d.second_weights_path, dir + "/yolo_fastest_1.1/yolo-fastest-1.1-xl.weights");
   EXPECT_EQ(d.second_names_path, dir + "/yolo_fastest_1.1/coco.names");
@@ -105,13 +105,13 @@ TEST(DnnOptions, SecondDetectorDefaultIsOptionalAndExplicitOneIsKept) {
   EXPECT_NE(std::find(looked.begin(), looked.end(), d.second_names_path), looked.end());
   // "none" turns it off even where the file exists; a named one is kept even when missing (the
   // segmenter then reports it as missing).
-  Settings off;
-  off.extra["Segmentation.SecondDetector"] = "none";
+  SegmenterSettings off;
+  off.second_detector = "none";
   EXPECT_TRUE(DnnOptionsFromSettings(off, dir).second_detector_path.empty());
-  Settings named;
-  named.extra["Segmentation.SecondDetector"] = "other/body.cfg";
-  named.extra["Segmentation.SecondScoreThreshold"] = "0.3";
-  named.extra["Segmentation.SecondEvery"] = "3";
+  SegmenterSettings named;
+  named.second_detector = "other/body.cfg";
+  named.dnn.second_score_threshold = 0.3f;
+  named.dnn.second_every = 3;
   EXPECT_EQ(DnnOptionsFromSettings(off, dir).second_every, 2);
   const DnnSegmenterOptions n = DnnOptionsFromSettings(named, "/m");
   EXPECT_EQ(n.second_every, 3);

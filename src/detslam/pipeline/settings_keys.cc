@@ -1,0 +1,234 @@
+#include "detslam/pipeline/settings_keys.h"
+
+#include <spdlog/spdlog.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <functional>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <type_traits>
+
+#include "detslam/core/check.h"
+
+namespace detslam {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+// ---- typed field <-> SettingValue ----
+
+template <typename T>
+constexpr SettingType TypeOf() {
+  if constexpr (std::is_same_v<T, bool>) return SettingType::kBool;
+  if constexpr (std::is_same_v<T, int>) return SettingType::kInt;
+  if constexpr (std::is_floating_point_v<T>) return SettingType::kDouble;
+  if constexpr (std::is_same_v<T, std::string>) return SettingType::kString;
+  if constexpr (std::is_same_v<T, std::vector<std::string>>) return SettingType::kList;
+}
+
+// A float field as the double its text names (0.35f -> 0.35, not 0.3499999940395355).
+double FloatAsDouble(float f) {
+  char buf[32];
+  std::snprintf(buf, sizeof(buf), "%.7g", f);
+  return std::strtod(buf, nullptr);
+}
+
+template <typename T>
+SettingValue ToValue(const T& field) {
+  if constexpr (std::is_same_v<T, float>) {
+    return FloatAsDouble(field);
+  } else {
+    return field;
+  }
+}
+
+template <typename T>
+void FromValue(const SettingValue& value, T* field) {
+  if constexpr (std::is_same_v<T, float>) {
+    *field = static_cast<float>(std::get<double>(value));
+  } else {
+    *field = std::get<T>(value);
+  }
+}
+
+// A declared key bound to the field(s) it fills. `field` is a generic lambda
+// `[](auto& r) -> auto& { return r.some.field; }` over ResolvedSettings.
+struct Binding {
+  SettingSpec spec;  // default_value filled by DeclaredSettings()
+  std::function<SettingValue(const ResolvedSettings&)> get;
+  std::function<void(const SettingValue&, ResolvedSettings*)> set;
+
+  // The key also fills `field` (same type as the first).
+  template <typename F>
+  Binding Also(F field) && {
+    set = [prev = set, field](const SettingValue& v, ResolvedSettings* r) {
+      prev(v, r);
+      FromValue(v, &field(*r));
+    };
+    return std::move(*this);
+  }
+};
+
+template <typename F>
+Binding Key(std::string key, double min, double max, std::string help, F field) {
+  using T = std::decay_t<decltype(field(std::declval<ResolvedSettings&>()))>;
+  Binding b;
+  b.spec.key = std::move(key);
+  b.spec.type = TypeOf<T>();
+  b.spec.min = min;
+  b.spec.max = max;
+  b.spec.help = std::move(help);
+  b.get = [field](const ResolvedSettings& r) { return ToValue(field(r)); };
+  b.set = [field](const SettingValue& v, ResolvedSettings* r) { FromValue(v, &field(*r)); };
+  return b;
+}
+
+template <typename F>
+Binding Key(std::string key, std::string help, F field) {
+  return Key(std::move(key), -kInf, kInf, std::move(help), field);
+}
+
+// ---- the declarations: every key exactly once ----
+
+// One line per key: name, [min, max,] help, the field it fills.
+// clang-format off
+std::vector<Binding> MakeBindings() {
+  std::vector<Binding> k;
+  // Tracking, local mapping, loop closing.
+  k.push_back(Key("Tracking.KeyFrameFarPoints", 0, kInf, "map points a keyframe creates from depth beyond ThDepth", [](auto& r) -> auto& { return r.run.slam.tracker.keyframe_far_points; }));
+  k.push_back(Key("LocalMapping.BundleAdjustment", "local bundle adjustment after each keyframe", [](auto& r) -> auto& { return r.run.slam.mapper.local_ba; }));
+  k.push_back(Key("LocalMapping.MaxLocalKeyFrames", 1, kInf, "keyframes optimised by local BA (current + best covisibles)", [](auto& r) -> auto& { return r.run.slam.mapper.max_local_keyframes; }));
+  k.push_back(Key("LocalMapping.Triangulate", "triangulate keypoints without close depth with covisible keyframes", [](auto& r) -> auto& { return r.run.slam.mapper.triangulate; }));
+  k.push_back(Key("LoopClosing.Enabled", "loop detection and correction", [](auto& r) -> auto& { return r.run.slam.loop.enabled; }));
+  k.push_back(Key("LoopClosing.CandidateRadius", 0, kInf, "loop candidates: keyframe centres within this distance (m)", [](auto& r) -> auto& { return r.run.slam.loop.candidate_radius_m; }));
+  k.push_back(Key("LoopClosing.GlobalBAIterations", 0, kInf, "global bundle adjustment iterations after a loop (0: none)", [](auto& r) -> auto& { return r.run.slam.loop.global_ba_iterations; }));
+  // Det-SLAM dynamic filter.
+  k.push_back(Key("Dynamic.Classes", "class names treated as dynamic (comma-separated); when set, the segmenter also returns only these (else all classes)", [](auto& r) -> auto& { return r.run.slam.dynamic.filter.dynamic_classes; })
+                  .Also([](auto& r) -> auto& { return r.segmenter.dnn.classes; })
+                  .Also([](auto& r) -> auto& { return r.segmenter.maskrcnn.classes; }));
+  k.push_back(Key("Dynamic.Alpha", 0, kInf, "depth-step widening factor alpha of the depth interval", [](auto& r) -> auto& { return r.run.slam.dynamic.filter.alpha; }));
+  k.push_back(Key("Dynamic.DepthStep", "the paper's depth-ROI step (off: mask step only)", [](auto& r) -> auto& { return r.run.slam.dynamic.filter.depth_step; }));
+  k.push_back(Key("Dynamic.MaskDilation", 0, kInf, "dilate dynamic masks by this many pixels", [](auto& r) -> auto& { return r.run.slam.dynamic.filter.mask_dilation_px; }));
+  k.push_back(Key("Dynamic.MinScore", 0, 1, "ignore instances scored below this", [](auto& r) -> auto& { return r.run.slam.dynamic.filter.min_score; }));
+  k.push_back(Key("Dynamic.PreMask", "drop dynamic corners before the ORB spatial distribution", [](auto& r) -> auto& { return r.run.slam.dynamic.premask; }));
+  k.push_back(Key("Dynamic.MemoryFrames", 0, kInf, "carry lost dynamic instances forward this many frames", [](auto& r) -> auto& { return r.run.slam.dynamic.memory_frames; }));
+  k.push_back(Key("Dynamic.GeometricCheck", "reject movers the segmenter missed by their residual against the tracked pose", [](auto& r) -> auto& { return r.run.slam.dynamic.geometric.enabled; }));
+  k.push_back(Key("Dynamic.GeometricK", 0, kInf, "geometric check threshold in robust standard deviations above the median", [](auto& r) -> auto& { return r.run.slam.dynamic.geometric.threshold.k; }));
+  k.push_back(Key("Dynamic.GeometricMinResidual", 0, kInf, "floor on the geometric check threshold (pixels)", [](auto& r) -> auto& { return r.run.slam.dynamic.geometric.threshold.min_threshold; }));
+  // Segmentation.
+  k.push_back(Key("Segmentation.EveryK", 1, kInf, "segment every K-th frame; masks follow the optical flow in between (--segment-every)", [](auto& r) -> auto& { return r.run.slam.dynamic.segment_every; }));
+  k.push_back(Key("Segmentation.Detector", "dnn: first detector, .onnx (YOLOX) or Darknet .cfg (relative: models folder)", [](auto& r) -> auto& { return r.segmenter.detector; }));
+  k.push_back(Key("Segmentation.Weights", "dnn: Darknet weights (empty: beside the detector)", [](auto& r) -> auto& { return r.segmenter.weights; }));
+  k.push_back(Key("Segmentation.Names", "dnn: class names file (empty: coco.names beside the detector)", [](auto& r) -> auto& { return r.segmenter.names; }));
+  k.push_back(Key("Segmentation.PersonMask", "dnn: person mask model (none: box masks at the dominant depth)", [](auto& r) -> auto& { return r.segmenter.person_mask; }));
+  k.push_back(Key("Segmentation.ScoreThreshold", 0, 1, "minimum detection score (dnn; maskrcnn uses 0.5 unless set)", [](auto& r) -> auto& { return r.segmenter.dnn.score_threshold; })
+                  .Also([](auto& r) -> auto& { return r.segmenter.maskrcnn.score_threshold; }));
+  k.push_back(Key("Segmentation.NmsThreshold", 0, 1, "dnn: IoU above which same-class boxes are suppressed", [](auto& r) -> auto& { return r.segmenter.dnn.nms_threshold; }));
+  k.push_back(Key("Segmentation.BoxExpand", 0, kInf, "dnn: person box grown by this fraction per side for the mask crop", [](auto& r) -> auto& { return r.segmenter.dnn.box_expand; }));
+  k.push_back(Key("Segmentation.InputSize", 32, kInf, "dnn: YOLOX input side (multiple of 32)", [](auto& r) -> auto& { return r.segmenter.dnn.yolox_input_size; }));
+  k.push_back(Key("Segmentation.PersonMaskMinFill", 0, 1, "dnn: person mask fill of the box below which the depth mask is used", [](auto& r) -> auto& { return r.segmenter.dnn.person_mask_min_fill; }));
+  k.push_back(Key("Segmentation.SecondDetector", "dnn: second detector for boxes the first missed (empty: yolo-fastest-1.1-xl when found; none)", [](auto& r) -> auto& { return r.segmenter.second_detector; }));
+  k.push_back(Key("Segmentation.SecondWeights", "dnn: Darknet weights of the second detector (empty: beside it)", [](auto& r) -> auto& { return r.segmenter.second_weights; }));
+  k.push_back(Key("Segmentation.SecondNames", "dnn: class names of the second detector (empty: beside it)", [](auto& r) -> auto& { return r.segmenter.second_names; }));
+  k.push_back(Key("Segmentation.SecondScoreThreshold", 0, 1, "dnn: minimum score of the second detector", [](auto& r) -> auto& { return r.segmenter.dnn.second_score_threshold; }));
+  k.push_back(Key("Segmentation.SecondEvery", 1, kInf, "dnn: run the second detector on every N-th segmented frame", [](auto& r) -> auto& { return r.segmenter.dnn.second_every; }));
+  k.push_back(Key("Segmentation.MaskRcnnGraph", "maskrcnn: frozen graph (.pb)", [](auto& r) -> auto& { return r.segmenter.maskrcnn_graph; }));
+  k.push_back(Key("Segmentation.MaskRcnnConfig", "maskrcnn: OpenCV graph config (.pbtxt)", [](auto& r) -> auto& { return r.segmenter.maskrcnn_config; }));
+  k.push_back(Key("Segmentation.MaskRcnnNames", "maskrcnn: class names file", [](auto& r) -> auto& { return r.segmenter.maskrcnn_names; }));
+  // Camera (read with the camera keys; settable with --set).
+  k.push_back(Key("RGBD.DisparitySigma", 0, kInf, "disparity noise (px) weighting the depth residual; 0: ORB-SLAM3's octave sigma", [](auto& r) -> auto& { return r.camera.disparity_sigma; }));
+  return k;
+}
+// clang-format on
+
+const std::vector<Binding>& Bindings() {
+  static const std::vector<Binding> bindings = [] {
+    std::vector<Binding> b = MakeBindings();
+    const ResolvedSettings defaults;
+    for (Binding& x : b) x.spec.default_value = x.get(defaults);
+    return b;
+  }();
+  return bindings;
+}
+
+// Keys that were renamed: old -> new.
+const std::map<std::string, std::string>& RenamedKeys() {
+  static const std::map<std::string, std::string> renamed = {
+      {"Segmentation.DynamicClasses", "Dynamic.Classes"}};
+  return renamed;
+}
+
+bool InOwnNamespace(const std::string& key) {
+  for (const char* prefix :
+       {"Tracking.", "LocalMapping.", "LoopClosing.", "Dynamic.", "Segmentation."}) {
+    if (key.rfind(prefix, 0) == 0) return true;
+  }
+  return false;
+}
+
+}  // namespace
+
+const std::vector<SettingSpec>& DeclaredSettings() {
+  static const std::vector<SettingSpec> specs = [] {
+    std::vector<SettingSpec> s;
+    for (const Binding& b : Bindings()) s.push_back(b.spec);
+    return s;
+  }();
+  return specs;
+}
+
+ResolvedSettings ResolveSettings(const Settings& settings) {
+  ResolvedSettings r;
+  r.camera = settings.camera;
+  std::string ignored;
+  for (const auto& [key, text] : settings.extra) {
+    const auto origin = settings.extra_origin.find(key);
+    const std::string where =
+        origin != settings.extra_origin.end() ? origin->second : settings.source;
+    const Binding* binding = nullptr;
+    for (const Binding& b : Bindings()) {
+      if (b.spec.key == key) binding = &b;
+    }
+    if (binding != nullptr) {
+      SettingValue value;
+      std::string why;
+      if (!ParseSettingValue(binding->spec, text, &value, &why))
+        throw InputError(where, 0, "key '" + key + "' " + why);
+      binding->set(value, &r);
+      continue;
+    }
+    const auto renamed = RenamedKeys().find(key);
+    if (renamed != RenamedKeys().end()) {
+      throw InputError(where, 0, "key '" + key + "' was renamed to '" + renamed->second + "'");
+    }
+    if (where.rfind("--set ", 0) == 0 || InOwnNamespace(key)) {
+      throw InputError(where, 0,
+                       "unknown key '" + key + "'; did you mean '" +
+                           ClosestSettingKey(key, DeclaredSettings()) +
+                           "'? (detslam settings --list)");
+    }
+    ignored += (ignored.empty() ? "" : ", ") + key;
+  }
+  if (!ignored.empty())
+    spdlog::debug("{}: keys detslam does not use, ignored: {}", settings.source, ignored);
+  return r;
+}
+
+std::vector<std::pair<std::string, SettingValue>> SettingValues(const ResolvedSettings& resolved) {
+  std::vector<std::pair<std::string, SettingValue>> values;
+  for (const Binding& b : Bindings()) values.emplace_back(b.spec.key, b.get(resolved));
+  return values;
+}
+
+nlohmann::json EffectiveSettingsJson(const Settings& settings, const RunOptions& options) {
+  ResolvedSettings r = ResolveSettings(settings);
+  r.run = options;
+  nlohmann::json j = nlohmann::json::object();
+  for (const auto& [key, value] : SettingValues(r)) {
+    std::visit([&j, k = key](const auto& v) { j[k] = v; }, value);
+  }
+  return j;
+}
+
+}  // namespace detslam

@@ -1,0 +1,31 @@
+// The segmenters' settings as typed values (Segmentation.* keys and Dynamic.Classes; declared,
+// parsed and range-checked once in pipeline/settings_keys.cc). Paths are as written: relative ones
+// resolve against the models folder when the backend's options are built
+// (DnnOptionsFromSettings, MaskRcnnOptionsFromSettings).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "detslam/segmentation/dnn_segmenter.h"
+#include "detslam/segmentation/mask_rcnn_segmenter.h"
+
+namespace detslam {
+
+struct SegmenterSettings {
+  std::string detector = "yolox_nano/yolox_nano.onnx";  // first detector (.onnx or Darknet .cfg)
+  std::string weights;  // Darknet weights; empty: beside the detector
+  std::string names;    // class names; empty: coco.names beside the detector
+  std::string person_mask = "selfie_segmentation/selfie_segmentation.onnx";  // "none": box masks
+  std::string second_detector;  // empty: yolo-fastest-1.1-xl when found; "none": one detector
+  std::string second_weights;   // Darknet weights of the second detector; empty: beside it
+  std::string second_names;     // class names of the second detector; empty: beside it
+  std::string maskrcnn_graph = "mask_rcnn_inception_v2_coco/frozen_inference_graph.pb";
+  std::string maskrcnn_config =
+      "mask_rcnn_inception_v2_coco/mask_rcnn_inception_v2_coco_2018_01_28.pbtxt";
+  std::string maskrcnn_names = "mask_rcnn_inception_v2_coco/object_detection_classes_coco.txt";
+  DnnSegmenterOptions dnn;   // thresholds, sizes, classes (its paths are filled from the above)
+  MaskRcnnOptions maskrcnn;  // score threshold, classes (its paths are filled from the above)
+};
+
+}  // namespace detslam
