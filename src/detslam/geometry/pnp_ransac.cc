@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core.hpp>
+#include <utility>
 
 #include "detslam/core/check.h"
 #include "detslam/geometry/ransac.h"
@@ -108,7 +109,7 @@ PnpResult SolvePnpRansac(const PinholeCamera& camera,
     if (!(s2 > 0.0)) throw InputError("SolvePnpRansac: sigma2 must be positive");
   }
   const PnpProblem problem(camera, points_world, pixels, sigma2, options.chi2_threshold);
-  const RansacOutcome<Rigid3d> outcome = RunRansac<Rigid3d>(
+  RansacOutcome<Rigid3d> outcome = RunRansac<Rigid3d>(
       static_cast<int>(points_world.size()), kSampleSize,
       std::max(kSampleSize, options.min_inliers), options, rng,
       [&](const std::vector<int>& sample, Rigid3d* pose) {
@@ -120,13 +121,7 @@ PnpResult SolvePnpRansac(const PinholeCamera& camera,
       [&](const std::vector<int>& inliers, const Rigid3d& start, Rigid3d* refined) {
         return problem.Solve(inliers, cv::SOLVEPNP_ITERATIVE, &start, refined);
       });
-  PnpResult result;
-  result.success = outcome.success;
-  result.cam_from_world = outcome.model;
-  result.inliers = outcome.inliers;
-  result.num_inliers = outcome.num_inliers;
-  result.iterations = outcome.iterations;
-  return result;
+  return ToRansacResult(std::move(outcome), &PnpResult::cam_from_world);
 }
 
 }  // namespace detslam

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <algorithm>
+#include <utility>
 #include <vector>
 
 #include "detslam/core/rng.h"
@@ -81,6 +82,19 @@ RansacOutcome<Model> RunRansac(int n, int sample_size, int min_refit_support,
   outcome.num_inliers = best_count;
   outcome.success = best_count >= options.min_inliers;
   return outcome;
+}
+
+// An estimator's public result (fields success, inliers, num_inliers, iterations) from the
+// outcome, with the model stored in `model_field`.
+template <typename Result, typename Model>
+Result ToRansacResult(RansacOutcome<Model> outcome, Model Result::*model_field) {
+  Result result;
+  result.success = outcome.success;
+  result.*model_field = outcome.model;
+  result.inliers = std::move(outcome.inliers);
+  result.num_inliers = outcome.num_inliers;
+  result.iterations = outcome.iterations;
+  return result;
 }
 
 }  // namespace detslam

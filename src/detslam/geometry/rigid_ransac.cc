@@ -2,6 +2,7 @@
 
 #include <Eigen/SVD>
 #include <string>
+#include <utility>
 
 #include "detslam/core/check.h"
 #include "detslam/geometry/ransac.h"
@@ -64,7 +65,7 @@ RigidRansacResult EstimateRigidRansac(const std::vector<Eigen::Vector3d>& a,
   if (!(inlier_threshold_m > 0.0)) {
     throw InputError("EstimateRigidRansac: inlier threshold must be positive");
   }
-  const RansacOutcome<Rigid3d> outcome = RunRansac<Rigid3d>(
+  RansacOutcome<Rigid3d> outcome = RunRansac<Rigid3d>(
       static_cast<int>(a.size()), kSampleSize, kSampleSize, options, rng,
       [&](const std::vector<int>& sample, Rigid3d* b_from_a) {
         return FitRigidKabsch(a, b, sample, b_from_a);
@@ -75,13 +76,7 @@ RigidRansacResult EstimateRigidRansac(const std::vector<Eigen::Vector3d>& a,
       [&](const std::vector<int>& inliers, const Rigid3d& /*start*/, Rigid3d* b_from_a) {
         return FitRigidKabsch(a, b, inliers, b_from_a);
       });
-  RigidRansacResult result;
-  result.success = outcome.success;
-  result.b_from_a = outcome.model;
-  result.inliers = outcome.inliers;
-  result.num_inliers = outcome.num_inliers;
-  result.iterations = outcome.iterations;
-  return result;
+  return ToRansacResult(std::move(outcome), &RigidRansacResult::b_from_a);
 }
 
 }  // namespace detslam
