@@ -13,9 +13,9 @@ namespace {
 
 StereoIntrinsics HandIntrinsics() { return {500.0, 400.0, 320.0, 240.0, 40.0}; }
 
-// cam_from_world: 90 deg about z, then + (0.1, 0, 1). World (-0.1, -0.2, 1) -> camera (0.3, -0.1,
-// 2)
-// -> u = 500 * 0.15 + 320 = 395, v = 400 * -0.05 + 240 = 220, u_right = 395 - 40 / 2 = 375.
+// cam_from_world: 90 deg about z, then + (0.1, 0, 1).
+// World (-0.1, -0.2, 1) -> camera (0.3, -0.1, 2) -> u = 500 * 0.15 + 320 = 395,
+// v = 400 * -0.05 + 240 = 220, u_right = 395 - 40 / 2 = 375.
 const double kQ[4] = {0.0, 0.0, std::sqrt(0.5), std::sqrt(0.5)};
 const double kT[3] = {0.1, 0.0, 1.0};
 const double kP[3] = {-0.1, -0.2, 1.0};
