@@ -1,12 +1,13 @@
-# detslam_module(NAME DEPS ...)
+# detslam_module(NAME DEPS ... [TEST_DEPS ...])
 # Builds src/detslam/NAME/*.cc (without *_test.cc) into the library detslam_NAME, and every
 # src/detslam/NAME/*_test.cc into one test binary detslam_NAME_test (ctest label "unit" unless the
-# test's name starts with Data, which gets the label "data"). A folder without sources yields an
+# test's name starts with Data, which gets the label "data"). TEST_DEPS: what only the tests link
+# besides the library (e.g. an OpenCV module the tests use and the library does not). A folder without sources yields an
 # INTERFACE library so that dependants link regardless.
 set(DETSLAM_WARNINGS -Wall -Wextra -Werror)
 
 function(detslam_module name)
-  cmake_parse_arguments(ARG "" "" "DEPS" ${ARGN})
+  cmake_parse_arguments(ARG "" "" "DEPS;TEST_DEPS" ${ARGN})
   set(dir "${CMAKE_SOURCE_DIR}/src/detslam/${name}")
   file(GLOB all_sources CONFIGURE_DEPENDS "${dir}/*.cc")
   file(GLOB test_sources CONFIGURE_DEPENDS "${dir}/*_test.cc")
@@ -27,8 +28,8 @@ function(detslam_module name)
   endif()
   if(DETSLAM_BUILD_TESTS AND test_sources)
     add_executable(${target}_test ${test_sources})
-    target_link_libraries(${target}_test PRIVATE ${target} detslam_test_support GTest::gmock
-                          GTest::gtest_main)
+    target_link_libraries(${target}_test PRIVATE ${target} ${ARG_TEST_DEPS} detslam_test_support
+                          GTest::gmock GTest::gtest_main)
     target_compile_options(${target}_test PRIVATE ${DETSLAM_WARNINGS})
     detslam_discover_tests(${target}_test)
   endif()

@@ -16,9 +16,8 @@ std::vector<std::pair<size_t, size_t>> AssociateTimestamps(const std::vector<Tim
   // us scan only the window around each a.
   std::vector<size_t> b_order(b.size());
   for (size_t j = 0; j < b.size(); ++j) b_order[j] = j;
-  std::sort(b_order.begin(), b_order.end(), [&](size_t x, size_t y) {
-    return std::tie(b[x].ns, x) < std::tie(b[y].ns, y);
-  });
+  std::sort(b_order.begin(), b_order.end(),
+            [&](size_t x, size_t y) { return std::tie(b[x].ns, x) < std::tie(b[y].ns, y); });
   std::vector<int64_t> b_shifted(b.size());
   for (size_t k = 0; k < b_order.size(); ++k) b_shifted[k] = b[b_order[k]].ns + offset_ns;
 

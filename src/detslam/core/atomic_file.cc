@@ -44,7 +44,9 @@ void WriteFileAtomically(const std::string& path, const std::function<void(std::
 }
 
 void WriteBytesAtomically(const std::string& path, const std::string& bytes) {
-  WriteFileAtomically(path, [&](std::ostream& out) { out.write(bytes.data(), static_cast<std::streamsize>(bytes.size())); });
+  WriteFileAtomically(path, [&](std::ostream& out) {
+    out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+  });
 }
 
 }  // namespace detslam

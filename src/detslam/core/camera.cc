@@ -8,7 +8,8 @@ namespace detslam {
 
 bool PinholeCamera::Check(std::string* error) const {
   std::ostringstream os;
-  if (width <= 0 || height <= 0) os << "image size must be positive (got " << width << "x" << height << "); ";
+  if (width <= 0 || height <= 0)
+    os << "image size must be positive (got " << width << "x" << height << "); ";
   if (!(fx > 0) || !(fy > 0)) os << "focal lengths must be positive; ";
   if (!std::isfinite(cx) || !std::isfinite(cy)) os << "principal point must be finite; ";
   if (!(depth_map_factor > 0)) os << "DepthMapFactor must be positive; ";

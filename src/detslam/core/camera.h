@@ -9,23 +9,23 @@
 namespace detslam {
 
 struct PinholeCamera {
-  int width = 640;                // image width in pixels
-  int height = 480;               // image height in pixels
-  double fx = 535.4;              // focal length x (pixels)
-  double fy = 539.2;              // focal length y (pixels)
-  double cx = 320.1;              // principal point x (pixels)
-  double cy = 247.6;              // principal point y (pixels)
+  int width = 640;                                // image width in pixels
+  int height = 480;                               // image height in pixels
+  double fx = 535.4;                              // focal length x (pixels)
+  double fy = 539.2;                              // focal length y (pixels)
+  double cx = 320.1;                              // principal point x (pixels)
+  double cy = 247.6;                              // principal point y (pixels)
   double k1 = 0, k2 = 0, p1 = 0, p2 = 0, k3 = 0;  // distortion (OpenCV order)
-  double fps = 30.0;              // frame rate (Hz)
-  double depth_map_factor = 5000.0;  // depth PNG value per metre
-  double bf = 40.0;               // virtual stereo baseline times fx (pixels * metres)
-  double th_depth = 40.0;         // close/far threshold in baselines (ORB-SLAM's ThDepth)
+  double fps = 30.0;                              // frame rate (Hz)
+  double depth_map_factor = 5000.0;               // depth PNG value per metre
+  double bf = 40.0;        // virtual stereo baseline times fx (pixels * metres)
+  double th_depth = 40.0;  // close/far threshold in baselines (ORB-SLAM's ThDepth)
   // Depth noise as a virtual-stereo disparity bf / depth (pixels): an RGB-D observation's third
   // residual is its disparity error over this (Kinect-class sensors: about bf * 1.4e-3 = 0.06 px,
   // nearly constant with depth). 0: ORB-SLAM3's u_right error with the keypoint's octave sigma,
   // which weights depth like a pixel of the image and so about 100-300 times below its accuracy.
   double disparity_sigma = 0.1;
-  bool rgb_order = true;          // true if colour images are RGB (Camera.RGB: 1)
+  bool rgb_order = true;  // true if colour images are RGB (Camera.RGB: 1)
 
   bool Check(std::string* error) const;
   bool HasDistortion() const { return k1 != 0 || k2 != 0 || p1 != 0 || p2 != 0 || k3 != 0; }

@@ -30,16 +30,16 @@ class InputError : public std::runtime_error {
 
 }  // namespace detslam
 
-#define DETSLAM_CHECK(condition)                                         \
-  do {                                                                   \
+#define DETSLAM_CHECK(condition)                                                  \
+  do {                                                                            \
     if (!(condition)) ::detslam::CheckFailed(__FILE__, __LINE__, #condition, ""); \
   } while (0)
 
-#define DETSLAM_CHECK_MSG(condition, message)                            \
-  do {                                                                   \
-    if (!(condition)) {                                                  \
-      std::ostringstream detslam_check_os_;                              \
-      detslam_check_os_ << message;                                      \
+#define DETSLAM_CHECK_MSG(condition, message)                                          \
+  do {                                                                                 \
+    if (!(condition)) {                                                                \
+      std::ostringstream detslam_check_os_;                                            \
+      detslam_check_os_ << message;                                                    \
       ::detslam::CheckFailed(__FILE__, __LINE__, #condition, detslam_check_os_.str()); \
-    }                                                                    \
+    }                                                                                  \
   } while (0)

@@ -18,7 +18,8 @@ class Rigid3d {
   static Rigid3d Identity() { return Rigid3d(); }
   // From a 4x4 homogeneous matrix (the rotation block is re-orthonormalised via the quaternion).
   static Rigid3d FromMatrix(const Eigen::Matrix4d& m) {
-    return Rigid3d(Eigen::Matrix3d(m.topLeftCorner<3, 3>()), Eigen::Vector3d(m.topRightCorner<3, 1>()));
+    return Rigid3d(Eigen::Matrix3d(m.topLeftCorner<3, 3>()),
+                   Eigen::Vector3d(m.topRightCorner<3, 1>()));
   }
   // Exponential map of a twist (rho: translation part, phi: rotation vector), SE(3) convention:
   // rotation = exp(phi), translation = J(phi) * rho.
@@ -40,9 +41,12 @@ class Rigid3d {
   double RotationAngle() const;
 
   Rigid3d operator*(const Rigid3d& b_from_c) const {
-    return Rigid3d(rotation_ * b_from_c.rotation_, rotation_ * b_from_c.translation_ + translation_);
+    return Rigid3d(rotation_ * b_from_c.rotation_,
+                   rotation_ * b_from_c.translation_ + translation_);
   }
-  Eigen::Vector3d operator*(const Eigen::Vector3d& p_a) const { return rotation_ * p_a + translation_; }
+  Eigen::Vector3d operator*(const Eigen::Vector3d& p_a) const {
+    return rotation_ * p_a + translation_;
+  }
 
  private:
   Eigen::Quaterniond rotation_;

@@ -20,7 +20,8 @@ TEST(ErrorStats, HandComputedOddAndEvenCounts) {
   // Even count: median is the mean of the two middle values (numpy.median).
   const ErrorStats even = ComputeErrorStats({4, 1, 10, 2});
   EXPECT_DOUBLE_EQ(even.median, 3.0);
-  EXPECT_DOUBLE_EQ(even.std, std::sqrt((3.25 * 3.25 + 0.25 * 0.25 + 2.25 * 2.25 + 5.75 * 5.75) / 4));
+  EXPECT_DOUBLE_EQ(even.std,
+                   std::sqrt((3.25 * 3.25 + 0.25 * 0.25 + 2.25 * 2.25 + 5.75 * 5.75) / 4));
 }
 
 TEST(ErrorStats, EmptyAndScaled) {

@@ -10,7 +10,9 @@ namespace detslam {
 struct Timestamp {
   int64_t ns = 0;
 
-  static Timestamp FromSeconds(double s) { return Timestamp{static_cast<int64_t>(std::llround(s * 1e9))}; }
+  static Timestamp FromSeconds(double s) {
+    return Timestamp{static_cast<int64_t>(std::llround(s * 1e9))};
+  }
   double Seconds() const { return static_cast<double>(ns) * 1e-9; }
   // Fixed-point text with 6 decimals (TUM style), exact for microsecond stamps.
   std::string ToString() const;

@@ -1,5 +1,6 @@
-// What `detslam report` reads back from a `detslam run` output folder: run.json (settings,
-// counts, per-stage timings and the per-frame log written by pipeline/runner.cc).
+// What `detslam report` reads back from a `detslam run` output folder: from run.json (written by
+// pipeline/runner.cc) the dataset, settings source, mode, segmenter, counts, wall time and the
+// per-frame log with its stage timings; the summary "timings" and the other keys are not read.
 #pragma once
 
 #include <cstdint>
@@ -11,14 +12,14 @@ namespace detslam {
 struct RunFrameLog {
   int64_t index = 0;
   double stamp = 0;      // colour image stamp (seconds)
-  std::string state;     // tracking state after the frame ("OK", "LOST", ...)
+  std::string state;     // tracking state after the frame ("ok", "lost", ...)
   bool tracked = false;  // the frame has a pose
   std::string method;    // how it was tracked ("motion", "reference", ...)
-  int inliers = 0;       // landmark inliers after local-map tracking
+  int inliers = 0;       // landmark inliers after local-map tracking (and the geometric check)
   bool keyframe = false;
   bool loop_closed = false;
-  int keypoints = 0;           // keypoints used for tracking
-  int dynamic_instances = 0;   // dynamic objects the segmenter reported
+  int keypoints = 0;           // keypoints left for tracking (after the dynamic filter)
+  int dynamic_instances = 0;   // instances the dynamic filter used (dynamic class, score >= min)
   int rejected_keypoints = 0;  // keypoints the dynamic filter rejected
   int geometric_rejected = 0;  // keypoints the geometric check labelled
   double segmentation_ms = 0, extraction_ms = 0, tracking_ms = 0, mapping_ms = 0;

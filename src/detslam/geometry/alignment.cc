@@ -8,8 +8,8 @@ namespace detslam {
 
 Alignment AlignPointSets(const std::vector<Eigen::Vector3d>& a,
                          const std::vector<Eigen::Vector3d>& b, bool with_scale) {
-  DETSLAM_CHECK_MSG(a.size() == b.size(), "point sets differ in size: " << a.size() << " vs "
-                                                                        << b.size());
+  DETSLAM_CHECK_MSG(a.size() == b.size(),
+                    "point sets differ in size: " << a.size() << " vs " << b.size());
   DETSLAM_CHECK_MSG(a.size() >= 3, "need at least 3 point pairs, got " << a.size());
   const double n = static_cast<double>(a.size());
   Eigen::Vector3d mean_a = Eigen::Vector3d::Zero();
@@ -34,8 +34,7 @@ Alignment AlignPointSets(const std::vector<Eigen::Vector3d>& a,
   const Eigen::JacobiSVD<Eigen::Matrix3d> svd(sigma, Eigen::ComputeFullU | Eigen::ComputeFullV);
   Eigen::Vector3d s_diag(1.0, 1.0, 1.0);
   if (svd.matrixU().determinant() * svd.matrixV().determinant() < 0.0) s_diag.z() = -1.0;
-  const Eigen::Matrix3d rotation =
-      svd.matrixU() * s_diag.asDiagonal() * svd.matrixV().transpose();
+  const Eigen::Matrix3d rotation = svd.matrixU() * s_diag.asDiagonal() * svd.matrixV().transpose();
 
   Alignment out;
   if (with_scale) {

@@ -17,11 +17,11 @@ struct Alignment {
 };
 
 // Minimises sum_i |b_i - (s R a_i + t)|^2 over R in SO(3), t, and s > 0 when `with_scale`
-// (s = 1 otherwise). Closed form: SVD of the cross-covariance Sigma = 1/n sum (b_i - mb)(a_i - ma)^T
-// = U D V^T, R = U S V^T with S = diag(1, 1, det(U) det(V)) (the reflection fix), s = tr(D S) /
-// var(a), t = mb - s R ma. Requires a.size() == b.size() >= 3 (CHECK); with_scale also requires a
-// to have non-zero spread (CHECK). Degenerate sets (collinear points) give one of the optimal
-// rotations.
+// (s = 1 otherwise). Closed form: SVD of the cross-covariance
+// Sigma = 1/n sum (b_i - mb)(a_i - ma)^T = U D V^T, R = U S V^T with S = diag(1, 1, det(U) det(V))
+// (the reflection fix), s = tr(D S) / var(a), t = mb - s R ma. Requires a.size() == b.size() >= 3
+// (CHECK); with_scale also requires a to have non-zero spread (CHECK). Degenerate sets (collinear
+// points) give one of the optimal rotations.
 Alignment AlignPointSets(const std::vector<Eigen::Vector3d>& a,
                          const std::vector<Eigen::Vector3d>& b, bool with_scale);
 

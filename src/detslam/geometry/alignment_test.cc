@@ -71,8 +71,7 @@ TEST(AlignPointSets, MirroredVolumeStillGivesProperRotation) {
 
 TEST(AlignPointSets, NoisySimilarityIsRecoveredClosely) {
   Rng rng(7);
-  const Eigen::Matrix3d r =
-      Eigen::AngleAxisd(0.7, V(1, -2, 0.5).normalized()).toRotationMatrix();
+  const Eigen::Matrix3d r = Eigen::AngleAxisd(0.7, V(1, -2, 0.5).normalized()).toRotationMatrix();
   const V t(-3, 0.5, 2);
   const double s = 0.8;
   std::vector<V> a, b;

@@ -3,8 +3,10 @@
 #include <algorithm>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core.hpp>
+#include <utility>
 
 #include "detslam/core/check.h"
+#include "detslam/geometry/ransac.h"
 
 namespace detslam {
 namespace {
@@ -91,24 +93,6 @@ class PnpProblem {
   cv::Matx33d k_;
 };
 
-std::vector<int> SampleDistinct(int n, int k, Rng& rng) {
-  std::vector<int> out;
-  out.reserve(k);
-  while (static_cast<int>(out.size()) < k) {
-    const int i = rng.UniformInt(0, n - 1);
-    if (std::find(out.begin(), out.end(), i) == out.end()) out.push_back(i);
-  }
-  return out;
-}
-
-std::vector<int> Indices(const std::vector<bool>& mask) {
-  std::vector<int> out;
-  for (size_t i = 0; i < mask.size(); ++i) {
-    if (mask[i]) out.push_back(static_cast<int>(i));
-  }
-  return out;
-}
-
 }  // namespace
 
 PnpResult SolvePnpRansac(const PinholeCamera& camera,
@@ -124,50 +108,20 @@ PnpResult SolvePnpRansac(const PinholeCamera& camera,
   for (const double s2 : sigma2) {
     if (!(s2 > 0.0)) throw InputError("SolvePnpRansac: sigma2 must be positive");
   }
-  PnpResult result;
-  const int n = static_cast<int>(points_world.size());
-  result.inliers.assign(n, false);
-  if (n < std::max(kSampleSize, options.min_inliers)) return result;
-
   const PnpProblem problem(camera, points_world, pixels, sigma2, options.chi2_threshold);
-  int best_count = -1;
-  Rigid3d best_pose;
-  std::vector<bool> mask;
-  int needed = options.max_iterations;
-  while (result.iterations < needed) {
-    ++result.iterations;
-    const std::vector<int> sample = SampleDistinct(n, kSampleSize, rng);
-    Rigid3d pose;
-    if (!problem.Solve(sample, cv::SOLVEPNP_AP3P, nullptr, &pose)) continue;
-    const int count = problem.Classify(pose, &mask);
-    if (count > best_count) {
-      best_count = count;
-      best_pose = pose;
-      needed = AdaptiveIterations(static_cast<double>(count) / n, kSampleSize, options.probability,
-                                  options.max_iterations);
-    }
-  }
-  if (best_count < std::max(kSampleSize, options.min_inliers)) return result;
-
-  // Refit on all inliers, starting from the best hypothesis; keep it while the support holds.
-  std::vector<bool> best_mask;
-  problem.Classify(best_pose, &best_mask);
-  for (int refit = 0; refit < 3; ++refit) {
-    Rigid3d refined;
-    if (!problem.Solve(Indices(best_mask), cv::SOLVEPNP_ITERATIVE, &best_pose, &refined)) break;
-    const int count = problem.Classify(refined, &mask);
-    if (count < best_count) break;
-    const bool same = (mask == best_mask);
-    best_pose = refined;
-    best_mask = mask;
-    best_count = count;
-    if (same) break;
-  }
-  result.cam_from_world = best_pose;
-  result.inliers = best_mask;
-  result.num_inliers = best_count;
-  result.success = best_count >= options.min_inliers;
-  return result;
+  RansacOutcome<Rigid3d> outcome = RunRansac<Rigid3d>(
+      static_cast<int>(points_world.size()), kSampleSize,
+      std::max(kSampleSize, options.min_inliers), options, rng,
+      [&](const std::vector<int>& sample, Rigid3d* pose) {
+        return problem.Solve(sample, cv::SOLVEPNP_AP3P, nullptr, pose);
+      },
+      [&](const Rigid3d& pose, std::vector<bool>* inliers) {
+        return problem.Classify(pose, inliers);
+      },
+      [&](const std::vector<int>& inliers, const Rigid3d& start, Rigid3d* refined) {
+        return problem.Solve(inliers, cv::SOLVEPNP_ITERATIVE, &start, refined);
+      });
+  return ToRansacResult(std::move(outcome), &PnpResult::cam_from_world);
 }
 
 }  // namespace detslam

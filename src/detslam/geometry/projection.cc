@@ -10,7 +10,8 @@ Eigen::Vector3d ProjectStereo(const PinholeCamera& camera, const Eigen::Vector3d
 }
 
 Eigen::Vector3d WhitenedStereoResidual(const PinholeCamera& camera, const Eigen::Vector3d& p_cam,
-                                       const Eigen::Vector2d& uv, double u_right, double sqrt_info) {
+                                       const Eigen::Vector2d& uv, double u_right,
+                                       double sqrt_info) {
   const Eigen::Vector3d proj = ProjectStereo(camera, p_cam);
   const double third = camera.disparity_sigma > 0
                            ? (camera.bf / p_cam.z() - (uv.x() - u_right)) / camera.disparity_sigma

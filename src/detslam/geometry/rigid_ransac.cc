@@ -1,10 +1,11 @@
 #include "detslam/geometry/rigid_ransac.h"
 
 #include <Eigen/SVD>
-#include <algorithm>
 #include <string>
+#include <utility>
 
 #include "detslam/core/check.h"
+#include "detslam/geometry/ransac.h"
 
 namespace detslam {
 namespace {
@@ -64,57 +65,18 @@ RigidRansacResult EstimateRigidRansac(const std::vector<Eigen::Vector3d>& a,
   if (!(inlier_threshold_m > 0.0)) {
     throw InputError("EstimateRigidRansac: inlier threshold must be positive");
   }
-  RigidRansacResult result;
-  const int n = static_cast<int>(a.size());
-  result.inliers.assign(n, false);
-  if (n < std::max(kSampleSize, options.min_inliers)) return result;
-
-  int best_count = -1;
-  Rigid3d best;
-  std::vector<bool> mask;
-  int needed = options.max_iterations;
-  std::vector<int> sample;
-  while (result.iterations < needed) {
-    ++result.iterations;
-    sample.clear();
-    while (static_cast<int>(sample.size()) < kSampleSize) {
-      const int i = rng.UniformInt(0, n - 1);
-      if (std::find(sample.begin(), sample.end(), i) == sample.end()) sample.push_back(i);
-    }
-    Rigid3d hypothesis;
-    if (!FitRigidKabsch(a, b, sample, &hypothesis)) continue;
-    const int count = Classify(a, b, hypothesis, inlier_threshold_m, &mask);
-    if (count > best_count) {
-      best_count = count;
-      best = hypothesis;
-      needed = AdaptiveIterations(static_cast<double>(count) / n, kSampleSize, options.probability,
-                                  options.max_iterations);
-    }
-  }
-  if (best_count < kSampleSize) return result;
-
-  std::vector<bool> best_mask;
-  Classify(a, b, best, inlier_threshold_m, &best_mask);
-  for (int refit = 0; refit < 3; ++refit) {
-    std::vector<int> indices;
-    for (int i = 0; i < n; ++i) {
-      if (best_mask[i]) indices.push_back(i);
-    }
-    Rigid3d refined;
-    if (!FitRigidKabsch(a, b, indices, &refined)) break;
-    const int count = Classify(a, b, refined, inlier_threshold_m, &mask);
-    if (count < best_count) break;
-    const bool same = (mask == best_mask);
-    best = refined;
-    best_mask = mask;
-    best_count = count;
-    if (same) break;
-  }
-  result.b_from_a = best;
-  result.inliers = best_mask;
-  result.num_inliers = best_count;
-  result.success = best_count >= options.min_inliers;
-  return result;
+  RansacOutcome<Rigid3d> outcome = RunRansac<Rigid3d>(
+      static_cast<int>(a.size()), kSampleSize, kSampleSize, options, rng,
+      [&](const std::vector<int>& sample, Rigid3d* b_from_a) {
+        return FitRigidKabsch(a, b, sample, b_from_a);
+      },
+      [&](const Rigid3d& b_from_a, std::vector<bool>* inliers) {
+        return Classify(a, b, b_from_a, inlier_threshold_m, inliers);
+      },
+      [&](const std::vector<int>& inliers, const Rigid3d& /*start*/, Rigid3d* b_from_a) {
+        return FitRigidKabsch(a, b, inliers, b_from_a);
+      });
+  return ToRansacResult(std::move(outcome), &RigidRansacResult::b_from_a);
 }
 
 }  // namespace detslam

@@ -23,7 +23,12 @@ constexpr LandmarkId kNoLandmark = -1;
 constexpr KeyFrameId kNoKeyFrame = -1;
 
 // Why a keypoint was withheld from tracking (diagnostics for the dynamic filter).
-enum class KeypointLabel : uint8_t { kStatic = 0, kDynamicMask = 1, kDynamicDepth = 2, kGeometric = 3 };
+enum class KeypointLabel : uint8_t {
+  kStatic = 0,
+  kDynamicMask = 1,
+  kDynamicDepth = 2,
+  kGeometric = 3
+};
 
 // Scale pyramid facts shared by all frames of a run.
 struct ScaleInfo {
@@ -37,11 +42,11 @@ struct ScaleInfo {
 };
 
 struct FrameFeatures {
-  std::vector<cv::KeyPoint> keypoints;   // as detected (distorted pixel coordinates)
-  std::vector<Eigen::Vector2d> undist;   // undistorted pixel coordinates
-  std::vector<float> depth;              // metres, <= 0 when unknown
-  std::vector<float> u_right;            // u - bf/depth, < 0 when unknown
-  cv::Mat descriptors;                   // N x 32, CV_8UC1
+  std::vector<cv::KeyPoint> keypoints;  // as detected (distorted pixel coordinates)
+  std::vector<Eigen::Vector2d> undist;  // undistorted pixel coordinates
+  std::vector<float> depth;             // metres, <= 0 when unknown
+  std::vector<float> u_right;           // u - bf/depth, < 0 when unknown
+  cv::Mat descriptors;                  // N x 32, CV_8UC1
   // Keypoints the Det-SLAM stage rejected, with their labels, kept for diagnostics only (tracking
   // never sees them; every keypoint above is static as far as the segmenter knows).
   std::vector<cv::KeyPoint> rejected_keypoints;
@@ -49,15 +54,17 @@ struct FrameFeatures {
   std::shared_ptr<const KeypointGrid> grid;  // area queries over `undist`
 
   size_t size() const { return keypoints.size(); }
-  const uint8_t* Descriptor(size_t i) const { return descriptors.ptr<uint8_t>(static_cast<int>(i)); }
+  const uint8_t* Descriptor(size_t i) const {
+    return descriptors.ptr<uint8_t>(static_cast<int>(i));
+  }
 };
 
 struct Frame {
-  int64_t index = 0;                 // position in the input sequence
+  int64_t index = 0;  // position in the input sequence
   Timestamp stamp;
   std::shared_ptr<const FrameFeatures> features;  // shared with the keyframe made from it
-  std::vector<LandmarkId> landmarks;  // per keypoint, kNoLandmark if none
-  std::vector<bool> outlier;          // per keypoint, set by pose optimisation
+  std::vector<LandmarkId> landmarks;              // per keypoint, kNoLandmark if none
+  std::vector<bool> outlier;                      // per keypoint, set by pose optimisation
   // Per keypoint, set by tracking: kGeometric where the geometric check found a mover the
   // segmenter missed (never used for new landmarks or frame-to-frame points); else kStatic.
   std::vector<KeypointLabel> labels;

@@ -10,7 +10,8 @@ namespace detslam {
 
 int Landmark::PredictScale(double distance, const ScaleInfo& scale) const {
   if (distance <= 0 || max_distance <= 0) return 0;
-  const int level = static_cast<int>(std::ceil(std::log(max_distance / distance) / scale.log_scale_factor));
+  const int level =
+      static_cast<int>(std::ceil(std::log(max_distance / distance) / scale.log_scale_factor));
   return std::clamp(level, 0, scale.num_levels() - 1);
 }
 
@@ -58,7 +59,8 @@ void Map::AddObservation(LandmarkId lm_id, KeyFrameId kf_id, size_t idx) {
   KeyFrame& kf = keyframe(kf_id);
   Landmark& lm = landmark(lm_id);
   DETSLAM_CHECK(idx < kf.landmarks.size());
-  DETSLAM_CHECK_MSG(kf.landmarks[idx] == kNoLandmark, "slot " << idx << " of keyframe " << kf_id << " taken");
+  DETSLAM_CHECK_MSG(kf.landmarks[idx] == kNoLandmark,
+                    "slot " << idx << " of keyframe " << kf_id << " taken");
   if (lm.observations.count(kf_id)) return;  // one observation per keyframe
   lm.observations[kf_id] = idx;
   kf.landmarks[idx] = lm_id;
@@ -81,7 +83,8 @@ void Map::EraseObservation(LandmarkId lm_id, KeyFrameId kf_id) {
 void Map::EraseLandmark(LandmarkId lm_id) {
   auto it = landmarks_.find(lm_id);
   if (it == landmarks_.end()) return;
-  for (const auto& [kf_id, idx] : it->second.observations) keyframes_.at(kf_id).landmarks[idx] = kNoLandmark;
+  for (const auto& [kf_id, idx] : it->second.observations)
+    keyframes_.at(kf_id).landmarks[idx] = kNoLandmark;
   landmarks_.erase(it);
 }
 
@@ -184,7 +187,8 @@ void Map::UpdateLandmarkGeometry(LandmarkId lm_id) {
 void Map::UpdateLandmarkDescriptor(LandmarkId lm_id) {
   Landmark& lm = landmark(lm_id);
   std::vector<const uint8_t*> descs;
-  for (const auto& [kf_id, idx] : lm.observations) descs.push_back(keyframe(kf_id).features->Descriptor(idx));
+  for (const auto& [kf_id, idx] : lm.observations)
+    descs.push_back(keyframe(kf_id).features->Descriptor(idx));
   if (descs.empty()) return;
   size_t best = 0;
   int best_median = std::numeric_limits<int>::max();

@@ -20,12 +20,12 @@ struct KeyFrame {
   Timestamp stamp;
   Rigid3d cam_from_world;
   std::shared_ptr<const FrameFeatures> features;
-  std::vector<LandmarkId> landmarks;        // per keypoint
+  std::vector<LandmarkId> landmarks;  // per keypoint
   // Per keypoint (may be empty: all static): kGeometric where the tracker's geometric check found
   // a mover in the frame this keyframe was made from; such keypoints never get new landmarks.
   std::vector<KeypointLabel> labels;
-  std::map<KeyFrameId, int> covisibility;   // neighbour -> shared landmarks (>= 1)
-  KeyFrameId parent = kNoKeyFrame;          // spanning tree
+  std::map<KeyFrameId, int> covisibility;  // neighbour -> shared landmarks (>= 1)
+  KeyFrameId parent = kNoKeyFrame;         // spanning tree
   std::set<KeyFrameId> children;
 
   Eigen::Vector3d Center() const { return cam_from_world.Inverse().translation(); }
@@ -34,9 +34,9 @@ struct KeyFrame {
 
 struct Landmark {
   LandmarkId id = kNoLandmark;
-  Eigen::Vector3d position;                     // in the world frame
-  std::map<KeyFrameId, size_t> observations;    // keyframe -> keypoint index
-  cv::Mat descriptor;                           // 1 x 32, most representative observation
+  Eigen::Vector3d position;                          // in the world frame
+  std::map<KeyFrameId, size_t> observations;         // keyframe -> keypoint index
+  cv::Mat descriptor;                                // 1 x 32, most representative observation
   Eigen::Vector3d normal = Eigen::Vector3d::Zero();  // mean viewing direction
   double min_distance = 0.0, max_distance = 0.0;     // scale-invariance distance bounds
   KeyFrameId reference_keyframe = kNoKeyFrame;
@@ -83,7 +83,9 @@ class Map {
   size_t NumKeyFrames() const { return keyframes_.size(); }
   size_t NumLandmarks() const { return landmarks_.size(); }
   const ScaleInfo& scale() const { return scale_; }
-  KeyFrameId first_keyframe() const { return keyframes_.empty() ? kNoKeyFrame : keyframes_.begin()->first; }
+  KeyFrameId first_keyframe() const {
+    return keyframes_.empty() ? kNoKeyFrame : keyframes_.begin()->first;
+  }
   // Number of landmarks of `kf` observed by at least `min_obs` keyframes.
   int TrackedLandmarks(KeyFrameId kf, int min_obs) const;
 

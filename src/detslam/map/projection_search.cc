@@ -65,20 +65,25 @@ std::vector<int> SearchByProjection(const PinholeCamera& camera, const ScaleInfo
     const Eigen::Vector2d uv = camera.Project(p_cam);
     if (!camera.InImage(uv)) continue;
     const double dist = (cand.position - center).norm();
-    if (cand.max_distance > 0 && (dist < 0.8 * cand.min_distance || dist > 1.2 * cand.max_distance)) continue;
-    if (cand.normal.squaredNorm() > 0 && (cand.position - center).dot(cand.normal) < 0.5 * dist) continue;
+    if (cand.max_distance > 0 && (dist < 0.8 * cand.min_distance || dist > 1.2 * cand.max_distance))
+      continue;
+    if (cand.normal.squaredNorm() > 0 && (cand.position - center).dot(cand.normal) < 0.5 * dist)
+      continue;
     int level = cand.predicted_level;
     if (level < 0) {
       level = 0;
       if (cand.max_distance > 0) {
-        level = static_cast<int>(std::ceil(std::log(cand.max_distance / dist) / scale.log_scale_factor));
+        level = static_cast<int>(
+            std::ceil(std::log(cand.max_distance / dist) / scale.log_scale_factor));
         level = std::clamp(level, 0, scale.num_levels() - 1);
       }
     }
     const double radius = options.window * scale.scale_factors[static_cast<size_t>(level)];
     const int min_level = options.level_window_from_prediction ? level - 1 : -1;
-    const int max_level = options.level_window_from_prediction ? level + (cand.predicted_level >= 0 ? 1 : 0) : -1;
-    const std::vector<size_t> near = features.grid->FeaturesInArea(uv.x(), uv.y(), radius, min_level, max_level);
+    const int max_level =
+        options.level_window_from_prediction ? level + (cand.predicted_level >= 0 ? 1 : 0) : -1;
+    const std::vector<size_t> near =
+        features.grid->FeaturesInArea(uv.x(), uv.y(), radius, min_level, max_level);
     const double ur = uv.x() - camera.bf / p_cam.z();
     int best = std::numeric_limits<int>::max(), second = std::numeric_limits<int>::max();
     int best_level = -1, second_level = -1;
@@ -109,7 +114,8 @@ std::vector<int> SearchByProjection(const PinholeCamera& camera, const ScaleInfo
   if (options.check_orientation) {
     for (size_t c = 0; c < candidates.size(); ++c) {
       if (result[c] < 0 || candidates[c].source_angle < 0) continue;
-      angle_diffs.push_back(candidates[c].source_angle - features.keypoints[static_cast<size_t>(result[c])].angle);
+      angle_diffs.push_back(candidates[c].source_angle -
+                            features.keypoints[static_cast<size_t>(result[c])].angle);
       angle_owner.push_back(c);
     }
     const std::vector<bool> keep = RotationConsistency(angle_diffs);

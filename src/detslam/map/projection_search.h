@@ -16,16 +16,16 @@ struct ProjectionCandidate {
   LandmarkId landmark = kNoLandmark;  // kNoLandmark for temporary (frame-to-frame) points
   Eigen::Vector3d position;           // world frame
   const uint8_t* descriptor = nullptr;
-  int predicted_level = -1;           // < 0: predict from distance bounds
-  double min_distance = 0, max_distance = 0;  // 0: no scale check
+  int predicted_level = -1;                          // < 0: predict from distance bounds
+  double min_distance = 0, max_distance = 0;         // 0: no scale check
   Eigen::Vector3d normal = Eigen::Vector3d::Zero();  // zero: no viewing-angle check
-  float source_angle = -1;            // keypoint angle in the source image (< 0: none)
+  float source_angle = -1;  // keypoint angle in the source image (< 0: none)
 };
 
 struct ProjectionSearchOptions {
-  double window = 3.0;          // search radius in pixels at level 0 (scaled by level)
-  double ratio = 0.8;           // best/second-best ratio (applied only within the same level)
-  int max_distance = 100;       // descriptor distance threshold (TH_HIGH)
+  double window = 3.0;             // search radius in pixels at level 0 (scaled by level)
+  double ratio = 0.8;              // best/second-best ratio (applied only within the same level)
+  int max_distance = 100;          // descriptor distance threshold (TH_HIGH)
   bool check_orientation = false;  // rotation-consistency histogram (needs source_angle)
   bool level_window_from_prediction = true;  // search levels [pred-1, pred]
 };

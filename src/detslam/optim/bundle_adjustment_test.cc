@@ -128,7 +128,8 @@ TEST(BundleAdjustmentTest, DisparityModelWeightsDepthByItsNoise) {
   for (const bool o : summary.outlier) flagged += o ? 1 : 0;
   EXPECT_LT(flagged, 0.1 * summary.outlier.size());
   ASSERT_TRUE(SolveBundle(URightCamera(), &with_u_right, BundleOptions()).usable);
-  EXPECT_LT(point_after, MeanPointError(with_u_right, s.truth)) << point_after << " vs " << MeanPointError(with_u_right, s.truth);
+  EXPECT_LT(point_after, MeanPointError(with_u_right, s.truth))
+      << point_after << " vs " << MeanPointError(with_u_right, s.truth);
 }
 
 TEST(BundleAdjustmentTest, FlagsCorruptedObservations) {

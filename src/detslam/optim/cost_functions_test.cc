@@ -13,9 +13,9 @@ namespace {
 
 StereoIntrinsics HandIntrinsics() { return {500.0, 400.0, 320.0, 240.0, 40.0}; }
 
-// cam_from_world: 90 deg about z, then + (0.1, 0, 1). World (-0.1, -0.2, 1) -> camera (0.3, -0.1,
-// 2)
-// -> u = 500 * 0.15 + 320 = 395, v = 400 * -0.05 + 240 = 220, u_right = 395 - 40 / 2 = 375.
+// cam_from_world: 90 deg about z, then + (0.1, 0, 1).
+// World (-0.1, -0.2, 1) -> camera (0.3, -0.1, 2) -> u = 500 * 0.15 + 320 = 395,
+// v = 400 * -0.05 + 240 = 220, u_right = 395 - 40 / 2 = 375.
 const double kQ[4] = {0.0, 0.0, std::sqrt(0.5), std::sqrt(0.5)};
 const double kT[3] = {0.1, 0.0, 1.0};
 const double kP[3] = {-0.1, -0.2, 1.0};
@@ -40,23 +40,6 @@ TEST(CostFunctionsTest, MonoResidualHandMade) {
   EXPECT_EQ(cost->num_residuals(), 2);
   EXPECT_NEAR(r[0], 0.5 * 5.0, 1e-12);
   EXPECT_NEAR(r[1], 0.5 * -10.0, 1e-12);
-}
-
-TEST(CostFunctionsTest, PoseOnlyResidualsHandMade) {
-  const Eigen::Vector3d p(kP[0], kP[1], kP[2]);
-  std::unique_ptr<ceres::CostFunction> stereo(
-      PoseOnlyStereoCost::Create(HandIntrinsics(), Eigen::Vector3d(395, 220, 376), p, 1.0));
-  std::unique_ptr<ceres::CostFunction> mono(
-      PoseOnlyMonoCost::Create(HandIntrinsics(), Eigen::Vector2d(396, 218), p, 3.0));
-  const double* params[] = {kQ, kT};
-  double rs[3], rm[2];
-  ASSERT_TRUE(stereo->Evaluate(params, rs, nullptr));
-  ASSERT_TRUE(mono->Evaluate(params, rm, nullptr));
-  EXPECT_NEAR(rs[0], 0.0, 1e-12);
-  EXPECT_NEAR(rs[1], 0.0, 1e-12);
-  EXPECT_NEAR(rs[2], -1.0, 1e-12);
-  EXPECT_NEAR(rm[0], -3.0, 1e-12);
-  EXPECT_NEAR(rm[1], 6.0, 1e-12);
 }
 
 // Probes the Jacobians (in the quaternion's tangent space) against numeric differentiation at a
@@ -97,19 +80,12 @@ void ExpectGradientsMatch(const ceres::CostFunction& cost, int num_blocks,
 }
 
 TEST(CostFunctionsTest, GradientCheckerAcceptsAllResiduals) {
-  const Eigen::Vector3d p(0.5, 0.3, 2.5);
   std::unique_ptr<ceres::CostFunction> c1(
       StereoReprojectionCost::Create(HandIntrinsics(), Eigen::Vector3d(400, 250, 390), 1.7));
   std::unique_ptr<ceres::CostFunction> c2(
       MonoReprojectionCost::Create(HandIntrinsics(), Eigen::Vector2d(400, 250), 0.8));
-  std::unique_ptr<ceres::CostFunction> c3(
-      PoseOnlyStereoCost::Create(HandIntrinsics(), Eigen::Vector3d(400, 250, 390), p, 1.2));
-  std::unique_ptr<ceres::CostFunction> c4(
-      PoseOnlyMonoCost::Create(HandIntrinsics(), Eigen::Vector2d(400, 250), p, 1.0));
   ExpectGradientsMatch(*c1, 3);
   ExpectGradientsMatch(*c2, 3);
-  ExpectGradientsMatch(*c3, 2);
-  ExpectGradientsMatch(*c4, 2);
 }
 
 // Disparity model: the third residual is (bf / z - (u_obs - u_right_obs)) / disparity_sigma,

@@ -125,8 +125,8 @@ class PoseProblem {
     int count = 0;
     Eigen::Vector3d p_cam, r;
     for (size_t i = 0; i < obs_.size(); ++i) {
-      const bool ok = Residual(camera_, obs_[i], pose, &p_cam, &r) &&
-                      r.squaredNorm() <= obs_[i].chi2_threshold;
+      const bool ok =
+          Residual(camera_, obs_[i], pose, &p_cam, &r) && r.squaredNorm() <= obs_[i].chi2_threshold;
       (*inliers)[i] = ok;
       count += ok ? 1 : 0;
     }
