@@ -134,6 +134,17 @@ TEST(IntegrationSlamDynamic, GroundTruthMasksRemoveThePeople) {
   EXPECT_GT(frames_with_people, 100) << "the filter saw people in too few frames";
 }
 
+// A synthetic `static` preset sequence in a fresh temporary folder; returns the folder.
+std::string WriteStaticSequence(const std::string& name, uint64_t seed, int frames) {
+  const std::string dir = TempDir(name);
+  SynthOptions so;
+  so.preset = "static";
+  so.seed = seed;
+  so.frames = frames;
+  WriteSequence(so, dir);
+  return dir;
+}
+
 // A segmenter that fails on frame `fail_at` (as a model file that cannot be read would).
 class FailingSegmenter : public Segmenter {
  public:
@@ -151,12 +162,7 @@ class FailingSegmenter : public Segmenter {
 // A stage that throws in its own thread ends the run with its message (no std::terminate, no
 // hang), in every mode, and leaves no trajectory behind.
 TEST(IntegrationRunner, AFailingStageEndsTheRunWithItsMessage) {
-  const std::string seq = TempDir("failing_stage");
-  SynthOptions so;
-  so.preset = "static";
-  so.seed = 1;
-  so.frames = 40;
-  WriteSequence(so, seq);
+  const std::string seq = WriteStaticSequence("failing_stage", 1, 40);
   const RgbdDataset dataset = RgbdDataset::Open(seq, {});
   const Settings settings = PresetForDataset(seq);
   for (const auto& [threaded, mapping_thread] : {std::pair{false, false}, {true, false}, {true, true}}) {
@@ -177,12 +183,7 @@ TEST(IntegrationRunner, AFailingStageEndsTheRunWithItsMessage) {
 }
 
 TEST(IntegrationSlamSynthetic, StaticPresetTracksEveryFrameWithinOneCentimetre) {
-  const std::string seq = TempDir("synth_static");
-  SynthOptions so;
-  so.preset = "static";
-  so.seed = 3;
-  so.frames = 240;
-  WriteSequence(so, seq);
+  const std::string seq = WriteStaticSequence("synth_static", 3, 240);
   const SlamRun run = RunAndEvaluate(seq, TempDir("synth_static_run"), 42);
   EXPECT_EQ(run.summary.tracked, run.summary.frames);
   EXPECT_LE(run.eval.ate.error_m.rmse, 0.01) << "ATE RMSE " << run.eval.ate.error_m.rmse;

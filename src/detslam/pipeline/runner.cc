@@ -115,7 +115,8 @@ SlamOptions SlamOptionsFromSettings(const Settings& settings, uint64_t seed) {
   o.orb.num_levels = settings.orb.n_levels;
   o.orb.ini_th_fast = settings.orb.ini_th_fast;
   o.orb.min_th_fast = settings.orb.min_th_fast;
-  o.tracker.seed = seed;
+  o.tracker.seed = seed;  // relocalisation RANSAC
+  o.loop.seed = seed;     // loop verification RANSAC
   o.tracker.max_frames_between_keyframes = std::max(1, static_cast<int>(std::lround(settings.camera.fps)));
   return o;
 }

@@ -106,6 +106,13 @@ TEST(SettingsKeysTest, KeysFillTheirFields) {
       SlamOptionsFromSettings(WithSet({"Dynamic.MaskDilation=7"}), 1).dynamic.filter.mask_dilation_px, 7);
 }
 
+// --seed reaches every RANSAC: relocalisation and loop verification.
+TEST(SettingsKeysTest, TheSeedReachesTrackingAndLoopClosing) {
+  const SlamOptions o = SlamOptionsFromSettings(WithSet({}), 1234);
+  EXPECT_EQ(o.tracker.seed, 1234u);
+  EXPECT_EQ(o.loop.seed, 1234u);
+}
+
 TEST(SettingsKeysTest, UnknownSetKeyIsAnErrorNamingTheClosestKey) {
   EXPECT_THAT(
       ErrorOf([] { ResolveSettings(WithSet({"Dynamic.Alpah=0.5"})); }),
