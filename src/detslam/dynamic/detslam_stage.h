@@ -7,8 +7,8 @@
 //    rasterised once (DynamicRegions: dilated masks, depth intervals), their pixel form goes to
 //    the ORB extractor (premask), each keypoint's depth is sampled once and every keypoint gets its
 //    label (mask step, depth step).
-//  - The geometric check for movers the segmenter missed needs the tracked pose: the tracker runs
-//    it (tracking/tracker_geometric.cc) with this stage's `geometric` options.
+//  - The geometric check for movers the segmenter missed (LabelMovers, mover_check.h, with this
+//    stage's `geometric` options) needs the tracked pose: the tracker calls it on each frame.
 #pragma once
 
 #include <opencv2/core.hpp>
