@@ -1,0 +1,24 @@
+// Bag-of-words vectors and the L1 similarity score between them (Galvez-Lopez and Tardos 2012).
+#pragma once
+
+#include <map>
+#include <vector>
+
+namespace detslam {
+
+// Sparse word id -> weight (tf * idf), L1-normalised by Vocabulary::Transform. Ordered by word id.
+using BowVector = std::map<int, double>;
+
+// The "direct index" of one image: vocabulary node id -> indices (rows of the descriptor matrix,
+// ascending) of the descriptors that pass through that node. Used to restrict descriptor matching
+// between two images to descriptors under the same node.
+using FeatureVector = std::map<int, std::vector<int>>;
+
+// L1 score s = 1 - 0.5 * || a/|a| - b/|b| ||_1, in [0, 1]; identical (up to scale) vectors score 1,
+// vectors without a common word score 0. An empty (or all-zero) vector scores 0 with anything.
+double ScoreL1(const BowVector& a, const BowVector& b);
+
+// Sum of |weights|.
+double L1Norm(const BowVector& v);
+
+}  // namespace detslam
