@@ -21,5 +21,6 @@ void AddRunCommand(CLI::App& app);
 void AddSegmentCommand(CLI::App& app);
 void AddReportCommand(CLI::App& app);
 void AddSettingsCommand(CLI::App& app);
+void AddVocabCommand(CLI::App& app);
 
 }  // namespace detslam::app

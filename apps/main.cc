@@ -1,4 +1,5 @@
-// The `detslam` command: subcommands run, eval, synth, segment, report, settings (see --help).
+// The `detslam` command: subcommands run, eval, synth, segment, report, settings, vocab (see
+// --help).
 #include <spdlog/spdlog.h>
 
 #include <exception>
@@ -12,15 +13,15 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   bool verbose = false;
   app.add_flag("-v,--verbose", verbose, "Debug logging");
-  app.parse_complete_callback([&] {
-    spdlog::set_level(verbose ? spdlog::level::debug : spdlog::level::info);
-  });
+  app.parse_complete_callback(
+      [&] { spdlog::set_level(verbose ? spdlog::level::debug : spdlog::level::info); });
   detslam::app::AddRunCommand(app);
   detslam::app::AddEvalCommand(app);
   detslam::app::AddSynthCommand(app);
   detslam::app::AddSegmentCommand(app);
   detslam::app::AddReportCommand(app);
   detslam::app::AddSettingsCommand(app);
+  detslam::app::AddVocabCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
