@@ -2,29 +2,19 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
-#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <string>
+
+#include "support/cli_runner.h"
 
 namespace detslam {
 namespace {
 
 namespace fs = std::filesystem;
 using ::testing::HasSubstr;
-
-// Runs the CLI with `args`, stdout and stderr into `log`; returns the exit status.
-int Cli(const std::string& args, const fs::path& log) {
-  const std::string cmd =
-      std::string(DETSLAM_CLI_PATH) + " " + args + " > '" + log.string() + "' 2>&1";
-  const int status = std::system(cmd.c_str());
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
-
-std::string Read(const fs::path& p) {
-  std::ifstream in(p);
-  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-}
+using testing::ReadFileBytes;
+using testing::RunCli;
 
 TEST(IntegrationReport, RunThenReportWithAccuracyAndPerFramePlots) {
   const fs::path dir = fs::temp_directory_path() / "detslam_it_report";
@@ -32,16 +22,17 @@ TEST(IntegrationReport, RunThenReportWithAccuracyAndPerFramePlots) {
   fs::create_directories(dir);
   const fs::path seq = dir / "seq", out = dir / "out", log = dir / "log.txt";
   ASSERT_EQ(
-      Cli("synth --preset walking_xyz --seed 1 --frames 40 --out '" + seq.string() + "'", log), 0)
-      << Read(log);
-  ASSERT_EQ(Cli("run --dataset '" + seq.string() + "' --segmenter gt --no-progress --out '" +
-                    out.string() + "'",
-                log),
+      RunCli("synth --preset walking_xyz --seed 1 --frames 40 --out '" + seq.string() + "'", log),
+      0)
+      << ReadFileBytes(log);
+  ASSERT_EQ(RunCli("run --dataset '" + seq.string() + "' --segmenter gt --no-progress --out '" +
+                       out.string() + "'",
+                   log),
             0)
-      << Read(log);
-  ASSERT_EQ(Cli("report --run '" + out.string() + "'", log), 0) << Read(log);
-  EXPECT_THAT(Read(log), HasSubstr("report: " + (out / "report.html").string()));
-  const std::string html = Read(out / "report.html");
+      << ReadFileBytes(log);
+  ASSERT_EQ(RunCli("report --run '" + out.string() + "'", log), 0) << ReadFileBytes(log);
+  EXPECT_THAT(ReadFileBytes(log), HasSubstr("report: " + (out / "report.html").string()));
+  const std::string html = ReadFileBytes(out / "report.html");
   EXPECT_THAT(html, HasSubstr("40 / 40 (100.0 %)"));
   EXPECT_THAT(html, HasSubstr("ATE (mm)"));  // ground truth found beside the run's dataset
   EXPECT_THAT(html, HasSubstr("(a) Top view"));
@@ -49,20 +40,21 @@ TEST(IntegrationReport, RunThenReportWithAccuracyAndPerFramePlots) {
   EXPECT_THAT(html, HasSubstr("segmenter</th><td>gt"));
 
   // Without ground truth (--no-eval) and to another file.
-  ASSERT_EQ(Cli("report --no-eval --run '" + out.string() + "' --out '" +
-                    (dir / "r2.html").string() + "'",
-                log),
+  ASSERT_EQ(RunCli("report --no-eval --run '" + out.string() + "' --out '" +
+                       (dir / "r2.html").string() + "'",
+                   log),
             0);
-  EXPECT_THAT(Read(dir / "r2.html"), HasSubstr("No ground truth given"));
+  EXPECT_THAT(ReadFileBytes(dir / "r2.html"), HasSubstr("No ground truth given"));
 
   // Bad input: a clear error naming the file, exit 1, no report written.
-  EXPECT_EQ(Cli("report --run '" + (dir / "nope").string() + "'", log), 1);
-  EXPECT_THAT(Read(log), HasSubstr("error: " + (dir / "nope").string() + ": not a folder"));
+  EXPECT_EQ(RunCli("report --run '" + (dir / "nope").string() + "'", log), 1);
+  EXPECT_THAT(ReadFileBytes(log),
+              HasSubstr("error: " + (dir / "nope").string() + ": not a folder"));
   fs::create_directories(dir / "broken");
   std::ofstream(dir / "broken" / "run.json") << "{\"dataset\": 1}\n";
-  EXPECT_EQ(Cli("report --run '" + (dir / "broken").string() + "'", log), 1);
-  EXPECT_THAT(Read(log), HasSubstr((dir / "broken" / "run.json").string() +
-                                   ": key 'dataset' has the wrong type"));
+  EXPECT_EQ(RunCli("report --run '" + (dir / "broken").string() + "'", log), 1);
+  EXPECT_THAT(ReadFileBytes(log), HasSubstr((dir / "broken" / "run.json").string() +
+                                            ": key 'dataset' has the wrong type"));
   EXPECT_FALSE(fs::exists(dir / "broken" / "report.html"));
   fs::remove_all(dir);
 }
