@@ -1,5 +1,4 @@
-// The `detslam` command: subcommands run, eval, synth, segment, report, settings, vocab (see
-// --help).
+// The `detslam` command: subcommands run, eval, synth, segment, report, settings, vocab (--help).
 #include <spdlog/spdlog.h>
 
 #include <exception>
@@ -13,8 +12,9 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   bool verbose = false;
   app.add_flag("-v,--verbose", verbose, "Debug logging");
-  app.parse_complete_callback(
-      [&] { spdlog::set_level(verbose ? spdlog::level::debug : spdlog::level::info); });
+  app.parse_complete_callback([&] {
+    spdlog::set_level(verbose ? spdlog::level::debug : spdlog::level::info);
+  });
   detslam::app::AddRunCommand(app);
   detslam::app::AddEvalCommand(app);
   detslam::app::AddSynthCommand(app);
