@@ -1,6 +1,7 @@
 // `detslam vocab train|info` end to end on a few generated images, and its errors on bad input.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <filesystem>
 #include <fstream>
@@ -19,7 +20,8 @@ using testing::ReadFileBytes;
 using testing::RunCli;
 
 TEST(IntegrationVocabCli, TrainThenInfoDeterministic) {
-  const fs::path dir = fs::temp_directory_path() / "detslam_it_vocab";
+  const fs::path dir =
+      fs::temp_directory_path() / ("detslam_it_vocab_" + std::to_string(::getpid()));
   fs::remove_all(dir);
   fs::create_directories(dir / "images");
   cv::RNG rng(3);

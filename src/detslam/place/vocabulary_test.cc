@@ -2,6 +2,7 @@
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <filesystem>
 #include <fstream>
@@ -83,7 +84,13 @@ void WriteBytes(const fs::path& p, const std::string& bytes) {
   std::ofstream(p, std::ios::binary) << bytes;
 }
 
-fs::path TempPath(const std::string& name) { return fs::path(::testing::TempDir()) / name; }
+// Unique per process and test: ctest runs the tests of this file in parallel processes.
+fs::path TempPath(const std::string& name) {
+  const ::testing::TestInfo* test = ::testing::UnitTest::GetInstance()->current_test_info();
+  const std::string prefix = std::to_string(::getpid()) + "_" +
+                             (test != nullptr ? std::string(test->name()) + "_" : std::string());
+  return fs::path(::testing::TempDir()) / (prefix + name);
+}
 
 TEST(VocabularyOptions, Check) {
   VocabularyOptions o;
