@@ -67,9 +67,6 @@ class DetSlamStage {
                             const cv::Mat& depth_m, const cv::Mat& ignore_mask,
                             const std::vector<Instance>* instances) const;
 
-  const DetSlamOptions& options() const { return options_; }
-  bool has_segmenter() const { return segmenter_ != nullptr; }
-
  private:
   DetSlamOptions options_;
   Segmenter* segmenter_;

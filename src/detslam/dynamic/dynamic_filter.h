@@ -108,9 +108,6 @@ class DynamicRegions {
   // mask is non-zero there.
   cv::Mat IgnoreMask(const cv::Mat& depth_m) const;
 
-  bool empty() const { return regions_.empty(); }
-  int instances_used() const { return instances_used_; }
-
  private:
   cv::Size image_size_;
   std::vector<Region> regions_;

@@ -46,13 +46,6 @@ std::vector<float> SampleKeypointDepth(const std::vector<cv::KeyPoint>& keypoint
 
 std::shared_ptr<FrameFeatures> BuildFrameFeatures(const PinholeCamera& camera,
                                                   std::vector<cv::KeyPoint> keypoints,
-                                                  cv::Mat descriptors, const cv::Mat& depth_m) {
-  std::vector<float> depth = SampleKeypointDepth(keypoints, depth_m);
-  return BuildFrameFeatures(camera, std::move(keypoints), std::move(descriptors), std::move(depth));
-}
-
-std::shared_ptr<FrameFeatures> BuildFrameFeatures(const PinholeCamera& camera,
-                                                  std::vector<cv::KeyPoint> keypoints,
                                                   cv::Mat descriptors, std::vector<float> depth) {
   DETSLAM_CHECK_MSG(depth.size() == keypoints.size(),
                     depth.size() << " depths for " << keypoints.size() << " keypoints");

@@ -83,12 +83,8 @@ ImageBounds UndistortedBounds(const PinholeCamera& camera);
 std::vector<float> SampleKeypointDepth(const std::vector<cv::KeyPoint>& keypoints,
                                        const cv::Mat& depth_m);
 
-// Builds a frame's features from extraction output and the depth image (CV_32FC1, metres):
-// depth as SampleKeypointDepth reads it; keypoints are undistorted.
-std::shared_ptr<FrameFeatures> BuildFrameFeatures(const PinholeCamera& camera,
-                                                  std::vector<cv::KeyPoint> keypoints,
-                                                  cv::Mat descriptors, const cv::Mat& depth_m);
-// The same with each keypoint's depth already sampled (SampleKeypointDepth).
+// Builds a frame's features from extraction output and each keypoint's depth (metres, <= 0
+// unknown; as SampleKeypointDepth reads it): keypoints are undistorted, u_right = u - bf / depth.
 std::shared_ptr<FrameFeatures> BuildFrameFeatures(const PinholeCamera& camera,
                                                   std::vector<cv::KeyPoint> keypoints,
                                                   cv::Mat descriptors, std::vector<float> depth);
