@@ -36,6 +36,7 @@ struct RunArgs {
   bool geometric_check = false;
   bool no_geometric_check = false;
   int segment_every = 0;  // 0: from the settings (Segmentation.EveryK, default 1)
+  std::string vocabulary;  // empty: from the settings (Place.Vocabulary, default the shipped one)
   std::vector<std::string> overrides;  // --set KEY=VALUE
 };
 
@@ -82,6 +83,7 @@ void Run(const RunArgs& a) {
   if (a.geometric_check) options.slam.dynamic.geometric.enabled = true;
   if (a.no_geometric_check) options.slam.dynamic.geometric.enabled = false;
   if (a.segment_every > 0) options.slam.dynamic.segment_every = a.segment_every;
+  if (!a.vocabulary.empty()) options.slam.vocabulary = a.vocabulary;
   std::string error;
   if (!options.slam.Check(&error)) throw InputError(settings.source, 0, error);
   const std::string models_dir = a.models.empty() ? DefaultModelsDir() : a.models;
@@ -136,6 +138,8 @@ void AddRunCommand(CLI::App& app) {
   auto* geo = cmd->add_flag("--geometric-check", args->geometric_check,
                             "Also reject movers the segmenter missed by their residual against the tracked pose (settings Dynamic.GeometricCheck, default on)");
   cmd->add_flag("--no-geometric-check", args->no_geometric_check, "Turn the geometric check off")->excludes(geo);
+  cmd->add_option("--vocabulary", args->vocabulary,
+                  "Bag-of-words vocabulary for relocalisation and loop detection, or none (settings Place.Vocabulary; default the shipped data/vocabulary/orb_k10_l5.dslvoc or $DETSLAM_VOCABULARY)");
   cmd->add_option("--segment-every", args->segment_every,
                   "Run the segmenter on every K-th frame only; masks follow the optical flow in between (settings Segmentation.EveryK, default 1)")
       ->check(CLI::PositiveNumber);

@@ -11,6 +11,7 @@
 #include "detslam/core/check.h"
 #include "detslam/core/rng.h"
 #include "detslam/features/orb_extractor.h"
+#include "detslam/place/default_vocabulary.h"
 #include "detslam/place/vocabulary.h"
 
 namespace detslam::app {
@@ -26,7 +27,8 @@ bool IsImageFile(const fs::path& p) {
          ext == ".ppm";
 }
 
-// Image paths of a folder (its image files, sorted by name) or of a list file: one image per line,
+// Image paths of an image file (itself), a folder (its image files, sorted by name) or a list
+// file: one image per line,
 // relative to the list's folder; blank lines and '#' comments skipped; of several fields on a line
 // (a TUM rgb.txt: "timestamp path") the last one is the path.
 std::vector<std::string> ImagesOf(const std::string& source) {
@@ -40,6 +42,8 @@ std::vector<std::string> ImagesOf(const std::string& source) {
     }
     if (ec) throw InputError(source, 0, "cannot list the folder: " + ec.message());
     std::sort(images.begin(), images.end());
+  } else if (IsImageFile(source) && fs::is_regular_file(source, ec)) {
+    images.push_back(source);
   } else {
     std::ifstream in(source);
     if (!in) throw InputError(source, 0, "no such folder or readable image list");
@@ -125,6 +129,27 @@ void Info(const std::string& path) {
             << "training images: " << vocabulary.training_images() << "\n";
 }
 
+// Pairwise L1 scores of the images' bag-of-words vectors (as SLAM computes them: the extractor's
+// default features), one row per image.
+void Score(const std::string& vocabulary_path, const std::vector<std::string>& sources) {
+  Vocabulary vocabulary;
+  vocabulary.Load(vocabulary_path.empty() ? DefaultVocabularyPath() : vocabulary_path);
+  std::vector<std::string> images;
+  for (const auto& source : sources) {
+    const auto more = ImagesOf(source);
+    images.insert(images.end(), more.begin(), more.end());
+  }
+  std::vector<BowVector> bows;
+  for (const cv::Mat& d : ExtractAll(images, OrbOptions{}.num_features)) {
+    bows.push_back(vocabulary.Transform(d));
+  }
+  for (size_t i = 0; i < images.size(); ++i) {
+    std::printf("%-40s", fs::path(images[i]).filename().string().c_str());
+    for (size_t j = 0; j < images.size(); ++j) std::printf(" %.3f", Vocabulary::Score(bows[i], bows[j]));
+    std::printf("\n");
+  }
+}
+
 }  // namespace
 
 void AddVocabCommand(CLI::App& app) {
@@ -154,6 +179,13 @@ void AddVocabCommand(CLI::App& app) {
   auto file = std::make_shared<std::string>();
   info->add_option("file", *file, "Vocabulary file")->required();
   info->callback([file] { Info(*file); });
+
+  auto* score = cmd->add_subcommand("score", "Print the pairwise bag-of-words scores of images");
+  auto score_vocabulary = std::make_shared<std::string>();
+  auto score_images = std::make_shared<std::vector<std::string>>();
+  score->add_option("--vocabulary", *score_vocabulary, "Vocabulary file (default: the shipped one)");
+  score->add_option("images", *score_images, "Images, folders or list files")->required();
+  score->callback([=] { Score(*score_vocabulary, *score_images); });
 }
 
 }  // namespace detslam::app

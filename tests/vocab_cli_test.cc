@@ -10,6 +10,7 @@
 #include <string>
 
 #include "support/cli_runner.h"
+#include "support/shared_data.h"
 
 namespace detslam {
 namespace {
@@ -64,6 +65,39 @@ TEST(IntegrationVocabCli, TrainThenInfoDeterministic) {
   std::ofstream(dir / "broken.voc") << "DSLMVOC";
   EXPECT_EQ(RunCli("vocab info '" + (dir / "broken.voc").string() + "'", log), 1);
   EXPECT_THAT(ReadFileBytes(log), HasSubstr("truncated"));
+  fs::remove_all(dir);
+}
+
+// The shipped vocabulary is what its recipe (data/vocabulary/README.md) builds, byte for byte: its
+// training images are the Debian packages' photographs and ../shared's TUM frames.
+TEST(DataVocabulary, ShippedFileIsReproducible) {
+  const fs::path folder = fs::path(DETSLAM_SOURCE_DIR) / "data" / "vocabulary";
+  const fs::path sources = folder / "sources.txt";
+  std::ifstream in(sources);
+  ASSERT_TRUE(in) << sources;
+  for (std::string line; std::getline(in, line);) {
+    if (line.empty() || line[0] == '#') continue;
+    const fs::path image = fs::path(line).is_absolute() ? fs::path(line) : folder / line;
+    if (fs::exists(image)) continue;
+    const std::string why = "training image missing: " + image.string() +
+                            " (apt-get install opencv-doc mate-backgrounds; ../shared)";
+    if (testing::InCi()) FAIL() << why;
+    GTEST_SKIP() << why;
+  }
+  const fs::path dir =
+      fs::temp_directory_path() / ("detslam_data_vocab_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const fs::path log = dir / "log.txt", out = dir / "rebuilt.dslvoc";
+  ASSERT_EQ(RunCli("vocab train --images '" + sources.string() +
+                       "' --k 10 --levels 5 --features 8000 --seed 1 --out '" + out.string() + "'",
+                   log),
+            0)
+      << ReadFileBytes(log);
+  const std::string rebuilt = ReadFileBytes(out);
+  ASSERT_FALSE(rebuilt.empty());
+  EXPECT_TRUE(rebuilt == ReadFileBytes(folder / "orb_k10_l5.dslvoc"))
+      << "the rebuilt vocabulary differs from data/vocabulary/orb_k10_l5.dslvoc";
   fs::remove_all(dir);
 }
 

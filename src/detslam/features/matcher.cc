@@ -13,6 +13,20 @@ std::vector<cv::DMatch> MatchBruteForce(const std::vector<cv::KeyPoint>& kp_a,
                                         const cv::Mat& desc_a,
                                         const std::vector<cv::KeyPoint>& kp_b,
                                         const cv::Mat& desc_b, const MatchOptions& options) {
+  MatchGroup all;
+  all.a.resize(kp_a.size());
+  all.b.resize(kp_b.size());
+  for (size_t i = 0; i < kp_a.size(); ++i) all.a[i] = static_cast<int>(i);
+  for (size_t j = 0; j < kp_b.size(); ++j) all.b[j] = static_cast<int>(j);
+  return MatchWithinGroups(kp_a, desc_a, kp_b, desc_b, {all}, options);
+}
+
+std::vector<cv::DMatch> MatchWithinGroups(const std::vector<cv::KeyPoint>& kp_a,
+                                          const cv::Mat& desc_a,
+                                          const std::vector<cv::KeyPoint>& kp_b,
+                                          const cv::Mat& desc_b,
+                                          const std::vector<MatchGroup>& groups,
+                                          const MatchOptions& options) {
   DETSLAM_CHECK_MSG(
       desc_a.rows == static_cast<int>(kp_a.size()) && desc_b.rows == static_cast<int>(kp_b.size()),
       "descriptor rows must equal keypoint counts");
@@ -25,33 +39,35 @@ std::vector<cv::DMatch> MatchBruteForce(const std::vector<cv::KeyPoint>& kp_a,
   std::vector<int> match_of_b(kp_b.size(), kNone);  // a index currently holding each b
   std::vector<int> best_b_of_a(kp_a.size(), kNone);
   std::vector<int> best_dist_of_a(kp_a.size(), std::numeric_limits<int>::max());
-  for (int i = 0; i < desc_a.rows; ++i) {
-    const uint8_t* da = desc_a.ptr<uint8_t>(i);
-    int best = std::numeric_limits<int>::max(), second = std::numeric_limits<int>::max();
-    int best_j = kNone;
-    for (int j = 0; j < desc_b.rows; ++j) {
-      const int d = DescriptorDistance(da, desc_b.ptr<uint8_t>(j));
-      if (d < best) {
-        second = best;
-        best = d;
-        best_j = j;
-      } else if (d < second) {
-        second = d;
+  for (const MatchGroup& group : groups) {
+    for (const int i : group.a) {
+      const uint8_t* da = desc_a.ptr<uint8_t>(i);
+      int best = std::numeric_limits<int>::max(), second = std::numeric_limits<int>::max();
+      int best_j = kNone;
+      for (const int j : group.b) {
+        const int d = DescriptorDistance(da, desc_b.ptr<uint8_t>(j));
+        if (d < best) {
+          second = best;
+          best = d;
+          best_j = j;
+        } else if (d < second) {
+          second = d;
+        }
       }
+      if (best > options.max_distance) continue;
+      if (second != std::numeric_limits<int>::max() &&
+          !(static_cast<double>(best) < options.ratio * second)) {
+        continue;
+      }
+      const int holder = match_of_b[best_j];
+      if (holder != kNone) {
+        if (best_dist_of_a[holder] <= best) continue;  // the earlier (lower-index) one wins ties
+        best_b_of_a[holder] = kNone;
+      }
+      match_of_b[best_j] = i;
+      best_b_of_a[i] = best_j;
+      best_dist_of_a[i] = best;
     }
-    if (best > options.max_distance) continue;
-    if (second != std::numeric_limits<int>::max() &&
-        !(static_cast<double>(best) < options.ratio * second)) {
-      continue;
-    }
-    const int holder = match_of_b[best_j];
-    if (holder != kNone) {
-      if (best_dist_of_a[holder] <= best) continue;  // the earlier (lower-index) one wins ties
-      best_b_of_a[holder] = kNone;
-    }
-    match_of_b[best_j] = i;
-    best_b_of_a[i] = best_j;
-    best_dist_of_a[i] = best;
   }
   for (size_t i = 0; i < kp_a.size(); ++i) {
     if (best_b_of_a[i] != kNone) {

@@ -26,6 +26,23 @@ std::vector<cv::DMatch> MatchBruteForce(const std::vector<cv::KeyPoint>& kp_a,
                                         const std::vector<cv::KeyPoint>& kp_b,
                                         const cv::Mat& desc_b, const MatchOptions& options);
 
+// Index groups for MatchWithinGroups: keypoints of a listed in `a` are matched only against the
+// keypoints of b listed in `b` of the same group. A keypoint may appear in at most one group.
+struct MatchGroup {
+  std::vector<int> a;  // indices into kp_a / desc_a, ascending
+  std::vector<int> b;  // indices into kp_b / desc_b, ascending
+};
+
+// MatchBruteForce restricted to pairs within the same group (e.g. descriptors under the same
+// vocabulary node: a bag-of-words direct index); same acceptance, conflict and orientation rules,
+// groups taken in order. MatchBruteForce is the one-group case with every index.
+std::vector<cv::DMatch> MatchWithinGroups(const std::vector<cv::KeyPoint>& kp_a,
+                                          const cv::Mat& desc_a,
+                                          const std::vector<cv::KeyPoint>& kp_b,
+                                          const cv::Mat& desc_b,
+                                          const std::vector<MatchGroup>& groups,
+                                          const MatchOptions& options);
+
 // Histogram of angle differences (degrees, any range; wrapped into [0, 360)) in `bins` equal bins.
 // Keeps the entries of the 3 most populated bins, except a 2nd/3rd bin holding less than 10% of
 // the most populated one. Ties between bins go to the lower bin. Returns one keep flag per entry.

@@ -79,6 +79,39 @@ TEST(MatchBruteForceTest, RatioDistanceAndOneToOne) {
   EXPECT_EQ(m[2].distance, 60.f);
 }
 
+TEST(MatchWithinGroupsTest, PairsOnlyWithinAGroup) {
+  Rng rng(8);
+  cv::Mat a0(1, 32, CV_8UC1), a1(1, 32, CV_8UC1);
+  for (cv::Mat* m : {&a0, &a1}) {
+    for (int i = 0; i < 32; ++i)
+      m->at<uint8_t>(0, i) = static_cast<uint8_t>(rng.UniformInt(0, 255));
+  }
+  cv::Mat desc_a, desc_b;
+  cv::vconcat(std::vector<cv::Mat>{a0, a1}, desc_a);
+  // b0 near a1, b1 near a0, b2 far from both.
+  cv::vconcat(std::vector<cv::Mat>{Flipped(a1, 0, 4), Flipped(a0, 0, 3), Flipped(a0, 0, 120)},
+              desc_b);
+  std::vector<cv::KeyPoint> kp_a(2, cv::KeyPoint(0, 0, 31, 10.f)),
+      kp_b(3, cv::KeyPoint(0, 0, 31, 10.f));
+  MatchOptions options;
+  options.check_orientation = false;
+  // Groups that keep each a away from its true partner: no match passes the distance test.
+  EXPECT_TRUE(
+      MatchWithinGroups(kp_a, desc_a, kp_b, desc_b, {{{0}, {0, 2}}, {{1}, {1}}}, options).empty());
+  // Groups that pair them: the same matches as brute force.
+  const std::vector<cv::DMatch> grouped =
+      MatchWithinGroups(kp_a, desc_a, kp_b, desc_b, {{{0}, {1, 2}}, {{1}, {0}}}, options);
+  const std::vector<cv::DMatch> brute = MatchBruteForce(kp_a, desc_a, kp_b, desc_b, options);
+  ASSERT_EQ(grouped.size(), 2u);
+  ASSERT_EQ(brute.size(), 2u);
+  for (size_t k = 0; k < 2; ++k) {
+    EXPECT_EQ(grouped[k].queryIdx, brute[k].queryIdx);
+    EXPECT_EQ(grouped[k].trainIdx, brute[k].trainIdx);
+  }
+  EXPECT_EQ(grouped[0].trainIdx, 1);
+  EXPECT_EQ(grouped[1].trainIdx, 0);
+}
+
 TEST(MatchBruteForceTest, OrientationCheckRemovesInconsistentRotation) {
   Rng rng(6);
   const int n = 40;

@@ -9,7 +9,9 @@
 #include "detslam/core/check.h"
 #include "detslam/features/matcher.h"
 #include "detslam/geometry/rigid_ransac.h"
+#include "detslam/map/place_candidates.h"
 #include "detslam/map/projection_search.h"
+#include "detslam/mapping/landmark_fusion.h"
 #include "detslam/mapping/map_bundle.h"
 #include "detslam/optim/pose_graph.h"
 #include "detslam/optim/pose_optimizer.h"
@@ -20,7 +22,8 @@ namespace detslam {
 bool LoopClosingOptions::Check(std::string* error) const {
   std::ostringstream os;
   if (min_keyframe_gap < 1) os << "min_keyframe_gap must be >= 1; ";
-  if (!(candidate_radius_m > 0)) os << "candidate_radius_m must be positive; ";
+  if (!(candidate_radius_m >= 0)) os << "candidate_radius_m must be >= 0; ";
+  if (consistent_detections < 1) os << "consistent_detections must be >= 1; ";
   if (max_candidates < 1) os << "max_candidates must be >= 1; ";
   if (min_matches < 3 || min_ransac_inliers < 3)
     os << "min_matches and min_ransac_inliers must be >= 3; ";
@@ -31,7 +34,10 @@ bool LoopClosingOptions::Check(std::string* error) const {
 }
 
 LoopCloser::LoopCloser(const PinholeCamera& camera, LoopClosingOptions options)
-    : camera_(camera), options_(options), rng_(options.seed) {
+    : camera_(camera),
+      options_(options),
+      rng_(options.seed),
+      consistency_(options.consistent_detections) {
   std::string error;
   DETSLAM_CHECK_MSG(options_.Check(&error), "invalid LoopClosingOptions: " << error);
 }
@@ -41,6 +47,36 @@ LoopClosingResult LoopCloser::Process(Map& map, KeyFrameId kf_id) {
   result.keyframe = kf_id;
   if (!options_.enabled || !map.HasKeyFrame(kf_id)) return result;
   if (last_loop_kf_ != kNoKeyFrame && kf_id - last_loop_kf_ < 5) return result;
+  const bool by_appearance = !map.keyframe(kf_id).features->bow.empty();
+  const std::vector<KeyFrameId> candidates =
+      by_appearance ? CandidatesByAppearance(map, kf_id) : CandidatesByPosition(map, kf_id);
+  for (const KeyFrameId candidate : candidates) {
+    Verified loop;
+    if (!Verify(map, kf_id, candidate, &loop)) continue;
+    Correct(map, kf_id, loop, &result);
+    result.closed = true;
+    result.candidate = candidate;
+    result.inliers = loop.inliers;
+    last_loop_kf_ = kf_id;
+    ++loops_closed_;
+    consistency_.Reset();
+    spdlog::info(
+        "loop closed: keyframe {} with keyframe {} ({} inliers, {} landmarks fused, correction "
+        "{:.3f} m)",
+        kf_id, candidate, loop.inliers, result.fused, result.correction_m);
+    break;
+  }
+  return result;
+}
+
+bool LoopCloser::WithinRadius(const Map& map, KeyFrameId kf_id, KeyFrameId other) const {
+  return (map.keyframe(other).Center() - map.keyframe(kf_id).Center()).norm() <
+         options_.candidate_radius_m;
+}
+
+std::vector<KeyFrameId> LoopCloser::CandidatesByPosition(const Map& map, KeyFrameId kf_id) const {
+  std::vector<KeyFrameId> out;
+  if (!(options_.candidate_radius_m > 0)) return out;  // no vocabulary and no radius: no loops
   const KeyFrame& kf = map.keyframe(kf_id);
   const Eigen::Vector3d center = kf.Center();
   std::vector<std::pair<double, KeyFrameId>> near;
@@ -53,32 +89,42 @@ LoopClosingResult LoopCloser::Process(Map& map, KeyFrameId kf_id) {
   std::sort(near.begin(), near.end());
   spdlog::debug("keyframe {}: {} loop candidates within {} m", kf_id, near.size(),
                 options_.candidate_radius_m);
-  if (near.size() > static_cast<size_t>(options_.max_candidates))
-    near.resize(static_cast<size_t>(options_.max_candidates));
-  for (const auto& [d, candidate] : near) {
-    (void)d;
-    Verified loop;
-    if (!Verify(map, kf_id, candidate, &loop)) continue;
-    Correct(map, kf_id, loop, &result);
-    result.closed = true;
-    result.candidate = candidate;
-    result.inliers = loop.inliers;
-    last_loop_kf_ = kf_id;
-    ++loops_closed_;
-    spdlog::info(
-        "loop closed: keyframe {} with keyframe {} ({} inliers, {} landmarks fused, correction "
-        "{:.3f} m)",
-        kf_id, candidate, loop.inliers, result.fused, result.correction_m);
-    break;
+  for (const auto& [d, id] : near) {
+    if (out.size() >= static_cast<size_t>(options_.max_candidates)) break;
+    out.push_back(id);
   }
-  return result;
+  return out;
+}
+
+std::vector<KeyFrameId> LoopCloser::CandidatesByAppearance(const Map& map, KeyFrameId kf_id) {
+  std::set<KeyFrameId> recent;
+  for (auto it = map.keyframes().rbegin(); it != map.keyframes().rend(); ++it) {
+    if (it->first <= kf_id - options_.min_keyframe_gap) break;
+    recent.insert(it->first);
+  }
+  std::vector<PlaceCandidate> found = LoopCandidates(map, kf_id, recent);
+  if (options_.candidate_radius_m > 0) {
+    found.erase(std::remove_if(
+                    found.begin(), found.end(),
+                    [&](const PlaceCandidate& c) { return !WithinRadius(map, kf_id, c.keyframe); }),
+                found.end());
+  }
+  std::vector<KeyFrameId> accepted = consistency_.Update(map, found);
+  spdlog::debug("keyframe {}: {} loop candidates by appearance, {} consistent", kf_id, found.size(),
+                accepted.size());
+  if (accepted.size() > static_cast<size_t>(options_.max_candidates))
+    accepted.resize(static_cast<size_t>(options_.max_candidates));
+  return accepted;
 }
 
 bool LoopCloser::Verify(const Map& map, KeyFrameId kf_id, KeyFrameId candidate_id, Verified* out) {
   const KeyFrame& kf = map.keyframe(kf_id);
   const FrameFeatures& f = *kf.features;
-  std::vector<LandmarkId> matched =
-      MatchKeyFrameLandmarks(map.keyframe(candidate_id), f, 0.9, kThHigh);
+  const KeyFrame& candidate = map.keyframe(candidate_id);
+  const bool by_node = !f.bow_nodes.empty() && !candidate.features->bow_nodes.empty();
+  std::vector<LandmarkId> matched = MatchKeyFrameLandmarks(
+      candidate, f, 0.9, kThHigh,
+      by_node ? DescriptorSearch::kVocabularyNode : DescriptorSearch::kBruteForce);
   std::vector<Eigen::Vector3d> world, cam;
   std::vector<size_t> kp;
   for (size_t i = 0; i < f.size(); ++i) {
@@ -121,13 +167,13 @@ bool LoopCloser::Verify(const Map& map, KeyFrameId kf_id, KeyFrameId candidate_i
   if (optimise() < options_.min_ransac_inliers) return false;
   std::vector<KeyFrameId> neighbourhood = map.BestCovisibles(candidate_id, 10);
   neighbourhood.push_back(candidate_id);
-  std::set<LandmarkId> seen(assoc.begin(), assoc.end());
+  std::set<LandmarkId> seen(assoc.begin(), assoc.end()), loop_side;
   std::vector<ProjectionCandidate> candidates;
   for (KeyFrameId n : neighbourhood) {
     for (LandmarkId lm : map.keyframe(n).landmarks) {
-      if (lm != kNoLandmark && map.HasLandmark(lm) && seen.insert(lm).second) {
-        candidates.push_back(CandidateFromLandmark(map.landmark(lm)));
-      }
+      if (lm == kNoLandmark || !map.HasLandmark(lm)) continue;
+      if (loop_side.insert(lm).second) out->loop_landmarks.push_back(lm);
+      if (seen.insert(lm).second) candidates.push_back(CandidateFromLandmark(map.landmark(lm)));
     }
   }
   std::vector<bool> taken(f.size());
@@ -188,6 +234,16 @@ void LoopCloser::Correct(Map& map, KeyFrameId kf_id, const Verified& loop,
       continue;
     }
     ++result->fused;
+  }
+  // Then over the whole neighbourhood: the loop side's landmarks projected into every keyframe of
+  // the group at its corrected pose (ORB-SLAM's SearchAndFuse); the loop side's landmarks win.
+  ProjectionSearchOptions fuse;
+  fuse.window = 4.0;
+  fuse.ratio = 1.0;
+  fuse.max_distance = kThLow;
+  for (KeyFrameId g : group) {
+    result->fused += FuseLandmarksInto(camera_, map, g, loop.loop_landmarks, initial.at(g), fuse,
+                                       FuseWinner::kSource);
   }
   for (KeyFrameId g : group) map.UpdateConnections(g);
 

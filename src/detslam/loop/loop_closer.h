@@ -6,9 +6,12 @@
 // ORB-SLAM's essential graph), moving every landmark with its reference keyframe, then a bundle
 // adjustment of the whole map.
 //
-// Place recognition has no bag-of-words index yet: candidates are the keyframes whose centre lies
-// within `candidate_radius_m` of the keyframe's (drift up to about that radius is recovered),
-// nearest first, at most `max_candidates` per keyframe, ranked by brute-force descriptor matches.
+// Candidates: with a vocabulary (keyframes carry bag-of-words vectors), by appearance among the
+// keyframes that are neither covisible with the new one nor among its `min_keyframe_gap` newest
+// (place_candidates.h), accepted once consistent over `consistent_detections` consecutive
+// keyframes; `candidate_radius_m` > 0 adds a position gate (candidate centre within that distance
+// of the new keyframe's). Without a vocabulary: the keyframes within `candidate_radius_m`, nearest
+// first (needs a radius > 0).
 #pragma once
 
 #include <map>
@@ -18,13 +21,15 @@
 #include "detslam/core/camera.h"
 #include "detslam/core/rng.h"
 #include "detslam/map/map.h"
+#include "detslam/map/place_candidates.h"
 
 namespace detslam {
 
 struct LoopClosingOptions {
   bool enabled = true;
   int min_keyframe_gap = 20;        // candidates at least this many keyframe ids older
-  double candidate_radius_m = 1.5;  // candidate keyframe centres within this distance
+  double candidate_radius_m = 0.0;  // > 0: candidate keyframe centres within this distance
+  int consistent_detections = 3;    // consecutive keyframes a candidate group must persist
   int max_candidates = 8;           // examined per keyframe (nearest first)
   int min_matches = 40;             // descriptor matches with depth to try RANSAC
   double ransac_inlier_m = 0.05;    // 3-D inlier distance (scaled by depth / 2 m, at least this)
@@ -63,14 +68,20 @@ class LoopCloser {
     KeyFrameId candidate = kNoKeyFrame;
     Rigid3d cam_from_world;           // corrected pose of the current keyframe
     std::vector<LandmarkId> matched;  // per keypoint of the current keyframe
+    // Landmarks of the candidate's neighbourhood, to fuse into the current keyframe's.
+    std::vector<LandmarkId> loop_landmarks;
     int inliers = 0;
   };
+  bool WithinRadius(const Map& map, KeyFrameId kf, KeyFrameId other) const;
+  std::vector<KeyFrameId> CandidatesByPosition(const Map& map, KeyFrameId kf) const;
+  std::vector<KeyFrameId> CandidatesByAppearance(const Map& map, KeyFrameId kf);
   bool Verify(const Map& map, KeyFrameId kf, KeyFrameId candidate, Verified* out);
   void Correct(Map& map, KeyFrameId kf, const Verified& loop, LoopClosingResult* result);
 
   PinholeCamera camera_;
   LoopClosingOptions options_;
   Rng rng_;
+  LoopConsistency consistency_;
   KeyFrameId last_loop_kf_ = kNoKeyFrame;
   int loops_closed_ = 0;
 };

@@ -68,4 +68,9 @@ std::shared_ptr<FrameFeatures> BuildFrameFeatures(const PinholeCamera& camera,
   return f;
 }
 
+void ComputeFrameBow(const Vocabulary& vocabulary, FrameFeatures* features) {
+  features->bow = vocabulary.Transform(features->descriptors, &features->bow_nodes,
+                                       vocabulary.levels() - kDirectIndexDepth);
+}
+
 }  // namespace detslam

@@ -14,6 +14,8 @@
 #include "detslam/core/rigid3d.h"
 #include "detslam/core/timestamp.h"
 #include "detslam/features/keypoint_grid.h"
+#include "detslam/place/bow_vector.h"
+#include "detslam/place/vocabulary.h"
 
 namespace detslam {
 
@@ -52,6 +54,10 @@ struct FrameFeatures {
   std::vector<cv::KeyPoint> rejected_keypoints;
   std::vector<KeypointLabel> rejected_labels;
   std::shared_ptr<const KeypointGrid> grid;  // area queries over `undist`
+  // Bag-of-words vector of the descriptors and their direct index (vocabulary nodes
+  // kDirectIndexDepth below the root); both empty when the run has no vocabulary.
+  BowVector bow;
+  FeatureVector bow_nodes;
 
   size_t size() const { return keypoints.size(); }
   const uint8_t* Descriptor(size_t i) const {
@@ -73,6 +79,13 @@ struct Frame {
 
   size_t size() const { return features ? features->size() : 0; }
 };
+
+// Depth below the vocabulary's root of the direct-index nodes (ORB-SLAM: 4 levels up of 6; with
+// k = 10 up to 100 nodes, so that a matching candidate set holds about 1% of the keypoints).
+constexpr int kDirectIndexDepth = 2;
+
+// Fills features->bow and features->bow_nodes from its descriptors.
+void ComputeFrameBow(const Vocabulary& vocabulary, FrameFeatures* features);
 
 // Bounds of undistorted keypoint positions (the image corners undistorted).
 ImageBounds UndistortedBounds(const PinholeCamera& camera);

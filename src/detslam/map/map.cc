@@ -19,6 +19,7 @@ KeyFrameId Map::AddKeyFrame(KeyFrame kf) {
   kf.id = next_keyframe_id_++;
   kf.landmarks.assign(kf.features->size(), kNoLandmark);
   const KeyFrameId id = kf.id;
+  if (!kf.features->bow.empty()) place_index_.Insert(id, kf.features->bow);
   keyframes_.emplace(id, std::move(kf));
   return id;
 }
@@ -122,6 +123,7 @@ void Map::EraseKeyFrame(KeyFrameId kf_id) {
     (void)w;
     if (HasKeyFrame(other)) keyframe(other).covisibility.erase(kf_id);
   }
+  place_index_.Erase(kf_id);
   keyframes_.erase(kf_id);
 }
 

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "detslam/map/frame.h"
+#include "detslam/place/keyframe_database.h"
 
 namespace detslam {
 
@@ -53,13 +54,15 @@ class Map {
  public:
   explicit Map(ScaleInfo scale) : scale_(std::move(scale)) {}
 
-  KeyFrameId AddKeyFrame(KeyFrame kf);  // assigns the id; landmarks vector must be all kNoLandmark
+  // Assigns the id; landmarks vector must be all kNoLandmark. A keyframe whose features have a
+  // bag-of-words vector enters the place index.
+  KeyFrameId AddKeyFrame(KeyFrame kf);
   LandmarkId AddLandmark(const Eigen::Vector3d& position, KeyFrameId reference);
   // Links landmark `lm` to keypoint `idx` of keyframe `kf` (both must exist, slot must be free).
   void AddObservation(LandmarkId lm, KeyFrameId kf, size_t idx);
   void EraseObservation(LandmarkId lm, KeyFrameId kf);
   void EraseLandmark(LandmarkId lm);
-  void EraseKeyFrame(KeyFrameId kf);  // reparents children, removes observations
+  void EraseKeyFrame(KeyFrameId kf);  // reparents children, removes observations and index entry
   // Merges `from` into `into` (all observations move; duplicates in one keyframe are dropped).
   void ReplaceLandmark(LandmarkId from, LandmarkId into);
 
@@ -83,6 +86,8 @@ class Map {
   size_t NumKeyFrames() const { return keyframes_.size(); }
   size_t NumLandmarks() const { return landmarks_.size(); }
   const ScaleInfo& scale() const { return scale_; }
+  // Bag-of-words inverted index over the keyframes (those made with a vocabulary).
+  const KeyFrameDatabase& place_index() const { return place_index_; }
   KeyFrameId first_keyframe() const {
     return keyframes_.empty() ? kNoKeyFrame : keyframes_.begin()->first;
   }
@@ -93,6 +98,7 @@ class Map {
   ScaleInfo scale_;
   std::map<KeyFrameId, KeyFrame> keyframes_;  // ordered: deterministic iteration
   std::map<LandmarkId, Landmark> landmarks_;
+  KeyFrameDatabase place_index_;
   KeyFrameId next_keyframe_id_ = 0;
   LandmarkId next_landmark_id_ = 0;
 };

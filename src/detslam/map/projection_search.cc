@@ -20,23 +20,30 @@ ProjectionCandidate CandidateFromLandmark(const Landmark& lm) {
 }
 
 std::vector<LandmarkId> MatchKeyFrameLandmarks(const KeyFrame& keyframe, const FrameFeatures& frame,
-                                               double ratio, int max_distance) {
-  std::vector<cv::KeyPoint> kps;
-  std::vector<LandmarkId> ids;
-  cv::Mat desc;
-  for (size_t i = 0; i < keyframe.size(); ++i) {
-    if (keyframe.landmarks[i] == kNoLandmark) continue;
-    kps.push_back(keyframe.features->keypoints[i]);
-    ids.push_back(keyframe.landmarks[i]);
-    desc.push_back(keyframe.features->descriptors.row(static_cast<int>(i)));
-  }
+                                               double ratio, int max_distance,
+                                               DescriptorSearch search) {
   std::vector<LandmarkId> out(frame.size(), kNoLandmark);
-  if (kps.empty() || frame.size() == 0) return out;
+  const FrameFeatures& kf = *keyframe.features;
+  std::vector<bool> has_landmark(keyframe.size());
+  for (size_t i = 0; i < keyframe.size(); ++i)
+    has_landmark[i] = keyframe.landmarks[i] != kNoLandmark;
+  std::vector<MatchGroup> groups;
+  if (search == DescriptorSearch::kVocabularyNode) {
+    groups = SharedNodeGroups(kf.bow_nodes, frame.bow_nodes, has_landmark);
+  } else {
+    MatchGroup all;
+    for (size_t i = 0; i < keyframe.size(); ++i) {
+      if (has_landmark[i]) all.a.push_back(static_cast<int>(i));
+    }
+    for (size_t j = 0; j < frame.size(); ++j) all.b.push_back(static_cast<int>(j));
+    groups.push_back(std::move(all));
+  }
   MatchOptions mo;
   mo.ratio = ratio;
   mo.max_distance = max_distance;
-  for (const cv::DMatch& m : MatchBruteForce(kps, desc, frame.keypoints, frame.descriptors, mo)) {
-    out[static_cast<size_t>(m.trainIdx)] = ids[static_cast<size_t>(m.queryIdx)];
+  for (const cv::DMatch& m : MatchWithinGroups(kf.keypoints, kf.descriptors, frame.keypoints,
+                                               frame.descriptors, groups, mo)) {
+    out[static_cast<size_t>(m.trainIdx)] = keyframe.landmarks[static_cast<size_t>(m.queryIdx)];
   }
   return out;
 }

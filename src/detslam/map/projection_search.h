@@ -36,10 +36,19 @@ ProjectionCandidate CandidateFromLandmark(const Landmark& landmark);
 // True for keypoints of `frame` already associated with a landmark.
 std::vector<bool> TakenMask(const Frame& frame);
 
-// Brute-force descriptor matching of a keyframe's landmark-bearing keypoints against a frame:
-// returns, per frame keypoint, the matched landmark (kNoLandmark where none).
-std::vector<LandmarkId> MatchKeyFrameLandmarks(const KeyFrame& keyframe, const FrameFeatures& frame,
-                                               double ratio, int max_distance);
+// How MatchKeyFrameLandmarks pairs descriptors.
+enum class DescriptorSearch {
+  kBruteForce,      // every landmark-bearing keypoint of the keyframe against every keypoint
+  kVocabularyNode,  // only within the same direct-index node (both need bow_nodes)
+};
+
+// Descriptor matching of a keyframe's landmark-bearing keypoints against a frame (MatchWithinGroups
+// rules, orientation check on): returns, per frame keypoint, the matched landmark (kNoLandmark
+// where none). kVocabularyNode needs both sides' bag-of-words direct index (an empty one matches
+// nothing).
+std::vector<LandmarkId> MatchKeyFrameLandmarks(
+    const KeyFrame& keyframe, const FrameFeatures& frame, double ratio, int max_distance,
+    DescriptorSearch search = DescriptorSearch::kBruteForce);
 
 // For each candidate, the index of the matched keypoint in `features` (or -1). Keypoints listed in
 // `taken` (same size as features; true = already associated) are skipped. Deterministic.

@@ -11,6 +11,7 @@
 #include "detslam/core/check.h"
 #include "detslam/features/matcher.h"
 #include "detslam/map/projection_search.h"
+#include "detslam/mapping/landmark_fusion.h"
 #include "detslam/mapping/map_bundle.h"
 #include "detslam/optim/bundle_adjustment.h"
 
@@ -90,35 +91,10 @@ void LocalMapper::FuseWithNeighbours(Map& map, KeyFrameId current, LocalMappingS
   opt.window = 3.0;
   opt.ratio = 1.0;
   opt.max_distance = kThLow;
-  // Projects `sources` into keyframe `into`; merges or adds observations.
   auto fuse_into = [&](KeyFrameId into, const std::vector<LandmarkId>& sources) {
-    std::vector<ProjectionCandidate> cands;
-    for (LandmarkId id : sources) {
-      if (!map.HasLandmark(id)) continue;
-      const Landmark& lm = map.landmark(id);
-      if (lm.observations.count(into)) continue;
-      cands.push_back(CandidateFromLandmark(lm));
-    }
-    const KeyFrame& kf = map.keyframe(into);
-    const std::vector<int> m =
-        SearchByProjection(camera_, map.scale(), *kf.features, kf.cam_from_world, cands, {}, opt);
-    for (size_t c = 0; c < cands.size(); ++c) {
-      if (m[c] < 0 || !map.HasLandmark(cands[c].landmark)) continue;
-      const size_t idx = static_cast<size_t>(m[c]);
-      const LandmarkId existing = map.keyframe(into).landmarks[idx];
-      const LandmarkId src = cands[c].landmark;
-      if (existing == src || map.landmark(src).observations.count(into)) continue;
-      if (existing != kNoLandmark && map.HasLandmark(existing)) {
-        if (map.landmark(existing).observations.size() >= map.landmark(src).observations.size()) {
-          map.ReplaceLandmark(src, existing);
-        } else {
-          map.ReplaceLandmark(existing, src);
-        }
-      } else {
-        map.AddObservation(src, into, idx);
-      }
-      ++summary->fused;
-    }
+    summary->fused +=
+        FuseLandmarksInto(camera_, map, into, sources, map.keyframe(into).cam_from_world, opt,
+                          FuseWinner::kMoreObserved);
   };
   for (KeyFrameId t : targets) {
     std::vector<LandmarkId> mine;

@@ -101,7 +101,8 @@ std::vector<Binding> MakeBindings() {
   k.push_back(Key("LocalMapping.MaxLocalKeyFrames", 1, kInf, "keyframes optimised by local BA (current + best covisibles)", [](auto& r) -> auto& { return r.run.slam.mapper.max_local_keyframes; }));
   k.push_back(Key("LocalMapping.Triangulate", "triangulate keypoints without close depth with covisible keyframes", [](auto& r) -> auto& { return r.run.slam.mapper.triangulate; }));
   k.push_back(Key("LoopClosing.Enabled", "loop detection and correction", [](auto& r) -> auto& { return r.run.slam.loop.enabled; }));
-  k.push_back(Key("LoopClosing.CandidateRadius", 0, kInf, "loop candidates: keyframe centres within this distance (m)", [](auto& r) -> auto& { return r.run.slam.loop.candidate_radius_m; }));
+  k.push_back(Key("LoopClosing.CandidateRadius", 0, kInf, "loop candidates: keyframe centres within this distance (m); 0: no position gate (needs a vocabulary)", [](auto& r) -> auto& { return r.run.slam.loop.candidate_radius_m; }));
+  k.push_back(Key("Place.Vocabulary", "bag-of-words vocabulary file for relocalisation and loop detection (empty: the shipped one; none: no place recognition) (--vocabulary)", [](auto& r) -> auto& { return r.run.slam.vocabulary; }));
   k.push_back(Key("LoopClosing.GlobalBAIterations", 0, kInf, "global bundle adjustment iterations after a loop (0: none)", [](auto& r) -> auto& { return r.run.slam.loop.global_ba_iterations; }));
   // Det-SLAM dynamic filter.
   k.push_back(Key("Dynamic.Classes", "class names treated as dynamic (comma-separated); when set, the segmenter also returns only these (else all classes)", [](auto& r) -> auto& { return r.run.slam.dynamic.filter.dynamic_classes; })
@@ -161,7 +162,7 @@ const std::map<std::string, std::string>& RenamedKeys() {
 
 bool InOwnNamespace(const std::string& key) {
   for (const char* prefix :
-       {"Tracking.", "LocalMapping.", "LoopClosing.", "Dynamic.", "Segmentation."}) {
+       {"Tracking.", "LocalMapping.", "LoopClosing.", "Place.", "Dynamic.", "Segmentation."}) {
     if (key.rfind(prefix, 0) == 0) return true;
   }
   return false;

@@ -1,4 +1,4 @@
-// detslam's own settings keys (Tracking.*, LocalMapping.*, LoopClosing.*, Dynamic.*,
+// detslam's own settings keys (Tracking.*, LocalMapping.*, LoopClosing.*, Place.*, Dynamic.*,
 // Segmentation.*, and RGBD.DisparitySigma), each declared once in settings_keys.cc with its type,
 // range and help and bound to the options field it fills; the default of a key is that field's
 // in-class default. `detslam settings --list` prints them.
@@ -33,7 +33,8 @@ const std::vector<SettingSpec>& DeclaredSettings();
 //   - a value of the wrong type or out of range,
 //   - a renamed key (Segmentation.DynamicClasses: use Dynamic.Classes),
 //   - an undeclared key from --set, or from a file in detslam's own namespaces (Tracking.,
-//     LocalMapping., LoopClosing., Dynamic., Segmentation.), with the closest declared key.
+//     LocalMapping., LoopClosing., Place., Dynamic., Segmentation.), with the closest declared
+//     key.
 // Other keys of a file (ORB-SLAM3's Viewer.*, System.*, IMU.*, ...) are ignored (debug log).
 ResolvedSettings ResolveSettings(const Settings& settings);
 

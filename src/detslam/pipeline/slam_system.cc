@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "detslam/core/check.h"
+#include "detslam/place/default_vocabulary.h"
 
 namespace detslam {
 namespace {
@@ -38,6 +39,8 @@ SlamSystem::SlamSystem(const PinholeCamera& camera, const SlamOptions& options,
     : camera_(camera),
       options_(options),
       extractor_(options.orb),
+      vocabulary_(options.vocabulary == "none" ? nullptr
+                                               : LoadSharedVocabulary(options.vocabulary)),
       dynamic_(options.dynamic, segmenter),
       store_(MakeScaleInfo(extractor_)),
       tracker_(camera, options.tracker, options.dynamic.geometric),
@@ -122,6 +125,7 @@ Frame SlamSystem::ExtractFrame(int64_t index, Timestamp stamp, const cv::Mat& gr
   auto features = BuildFrameFeatures(camera_, std::move(kept), kept_desc, std::move(kept_depth));
   features->rejected_keypoints = std::move(rejected);
   features->rejected_labels = std::move(rejected_labels);
+  if (vocabulary_) ComputeFrameBow(*vocabulary_, features.get());
   frame.features = std::move(features);
   report->index = index;
   report->stamp = stamp;

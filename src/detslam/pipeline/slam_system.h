@@ -4,6 +4,7 @@
 #pragma once
 
 #include <map>
+#include <memory>
 #include <opencv2/core.hpp>
 #include <string>
 #include <vector>
@@ -15,6 +16,7 @@
 #include "detslam/map/map.h"
 #include "detslam/map/map_store.h"
 #include "detslam/mapping/local_mapper.h"
+#include "detslam/place/vocabulary.h"
 #include "detslam/tracking/tracker.h"
 
 namespace detslam {
@@ -25,6 +27,10 @@ struct SlamOptions {
   LocalMapperOptions mapper;
   LoopClosingOptions loop;  // loop closing after local mapping of each keyframe
   DetSlamOptions dynamic;   // the Det-SLAM stage (segmentation, filter, geometric check)
+  // Bag-of-words vocabulary for relocalisation and loop detection: a file, "" for the shipped one
+  // (DefaultVocabularyPath), or "none": no place recognition (relocalisation tries every keyframe
+  // by brute force, loops are found by position only).
+  std::string vocabulary;
   bool Check(std::string* error) const;
 };
 
@@ -54,7 +60,8 @@ struct FrameReport {
 // bookkeeping.
 class SlamSystem {
  public:
-  // `segmenter` (may be null: no dynamic-object filtering) feeds the Det-SLAM stage.
+  // `segmenter` (may be null: no dynamic-object filtering) feeds the Det-SLAM stage. Throws
+  // InputError when the vocabulary cannot be loaded.
   SlamSystem(const PinholeCamera& camera, const SlamOptions& options,
              Segmenter* segmenter = nullptr);
   SlamSystem(const SlamSystem&) = delete;
@@ -100,6 +107,7 @@ class SlamSystem {
   PinholeCamera camera_;
   SlamOptions options_;
   OrbExtractor extractor_;
+  std::shared_ptr<const Vocabulary> vocabulary_;  // null with vocabulary "none"
   DetSlamStage dynamic_;
   MapStore store_;  // the map's one owner; its lock also guards everything below
   Tracker tracker_;

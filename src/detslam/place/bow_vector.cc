@@ -33,4 +33,28 @@ double ScoreL1(const BowVector& a, const BowVector& b) {
   return std::clamp(1.0 - 0.5 * distance, 0.0, 1.0);
 }
 
+std::vector<MatchGroup> SharedNodeGroups(const FeatureVector& a, const FeatureVector& b,
+                                         const std::vector<bool>& keep_a) {
+  std::vector<MatchGroup> groups;
+  auto ia = a.begin();
+  auto ib = b.begin();
+  while (ia != a.end() && ib != b.end()) {
+    if (ia->first < ib->first) {
+      ++ia;
+    } else if (ib->first < ia->first) {
+      ++ib;
+    } else {
+      MatchGroup g;
+      for (const int i : ia->second) {
+        if (keep_a.empty() || keep_a[static_cast<size_t>(i)]) g.a.push_back(i);
+      }
+      g.b = ib->second;
+      if (!g.a.empty() && !g.b.empty()) groups.push_back(std::move(g));
+      ++ia;
+      ++ib;
+    }
+  }
+  return groups;
+}
+
 }  // namespace detslam

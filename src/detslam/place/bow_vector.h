@@ -4,6 +4,8 @@
 #include <map>
 #include <vector>
 
+#include "detslam/features/matcher.h"
+
 namespace detslam {
 
 // Sparse word id -> weight (tf * idf), L1-normalised by Vocabulary::Transform. Ordered by word id.
@@ -17,6 +19,12 @@ using FeatureVector = std::map<int, std::vector<int>>;
 // L1 score s = 1 - 0.5 * || a/|a| - b/|b| ||_1, in [0, 1]; identical (up to scale) vectors score 1,
 // vectors without a common word score 0. An empty (or all-zero) vector scores 0 with anything.
 double ScoreL1(const BowVector& a, const BowVector& b);
+
+// The nodes two direct indexes share, in node order, as match groups (a: indices of `a`'s
+// descriptors under the node, b: those of `b`), for MatchWithinGroups. `keep_a` (may be empty:
+// all) leaves out a's descriptors whose flag is false; groups left without a or b are dropped.
+std::vector<MatchGroup> SharedNodeGroups(const FeatureVector& a, const FeatureVector& b,
+                                         const std::vector<bool>& keep_a = {});
 
 // Sum of |weights|.
 double L1Norm(const BowVector& v);

@@ -59,5 +59,41 @@ TEST(KeyFrameDatabase, EraseAndReinsert) {
   EXPECT_TRUE(db.KeyFramesWithWord(3).empty());
 }
 
+TEST(KeyFrameDatabase, QueryOptionsFilterByCommonWordsScoreAndExclusion) {
+  KeyFrameDatabase db;
+  db.Insert(1, {{1, 1.0}, {2, 1.0}, {3, 1.0}});  // shares 3 words with the query
+  db.Insert(2, {{1, 1.0}, {9, 3.0}});            // shares 1 word
+  db.Insert(3, {{1, 1.0}, {2, 1.0}, {3, 1.0}, {4, 1.0}});
+  const BowVector query = {{1, 1.0}, {2, 1.0}, {3, 1.0}};
+  KeyFrameDatabase::QueryOptions o;
+  auto all = db.Query(query, o);
+  ASSERT_EQ(all.size(), 3u);
+  EXPECT_EQ(all[0].id, 1);
+  EXPECT_EQ(all[0].common_words, 3);
+  EXPECT_EQ(all[2].id, 2);
+  EXPECT_EQ(all[2].common_words, 1);
+  o.min_common_ratio = 0.8;  // more than 0.8 * 3 shared words: 1 and 3
+  EXPECT_EQ(db.Query(query, o).size(), 2u);
+  o.exclude = [](KeyFrameDatabase::Id id) { return id == 1; };
+  const auto without_1 = db.Query(query, o);
+  ASSERT_EQ(without_1.size(), 1u);
+  EXPECT_EQ(without_1[0].id, 3);
+  o.min_score = 0.8;  // keyframe 3 scores 0.75
+  EXPECT_TRUE(db.Query(query, o).empty());
+}
+
+TEST(SharedNodeGroups, PairsTheNodesBothDirectIndexesHold) {
+  const FeatureVector a = {{3, {0, 2}}, {5, {1}}, {8, {3}}};
+  const FeatureVector b = {{3, {4}}, {4, {0}}, {8, {1, 2}}};
+  auto groups = SharedNodeGroups(a, b);
+  ASSERT_EQ(groups.size(), 2u);
+  EXPECT_EQ(groups[0].a, (std::vector<int>{0, 2}));
+  EXPECT_EQ(groups[0].b, (std::vector<int>{4}));
+  EXPECT_EQ(groups[1].a, (std::vector<int>{3}));
+  EXPECT_EQ(groups[1].b, (std::vector<int>{1, 2}));
+  // Leaving out a's descriptors 0, 2 and 3 drops both groups.
+  EXPECT_TRUE(SharedNodeGroups(a, b, {false, true, false, false}).empty());
+}
+
 }  // namespace
 }  // namespace detslam

@@ -7,6 +7,7 @@
 
 #include "detslam/features/matcher.h"
 #include "detslam/geometry/pnp_ransac.h"
+#include "detslam/map/place_candidates.h"
 #include "detslam/map/projection_search.h"
 #include "detslam/tracking/tracker.h"
 
@@ -100,15 +101,22 @@ bool Tracker::TrackLocalMap(Map& map, Frame* frame, int* inliers) {
 }
 
 bool Tracker::Relocalize(const Map& map, Frame* frame) {
-  // Candidates: every keyframe, newest first (no place-recognition index yet); the first one
-  // that yields a verified pose wins.
+  // Candidates: with a vocabulary, the keyframes the bag-of-words index proposes (best group
+  // first), matched within direct-index nodes; without one, every keyframe, newest first, matched
+  // by brute force. The first one that yields a verified pose wins.
   const FrameFeatures& f = *frame->features;
+  const bool by_words = !f.bow.empty();
   std::vector<KeyFrameId> kfs;
-  for (auto it = map.keyframes().rbegin(); it != map.keyframes().rend(); ++it)
-    kfs.push_back(it->first);
+  if (by_words) {
+    for (const PlaceCandidate& c : RelocalizationCandidates(map, f.bow)) kfs.push_back(c.keyframe);
+  } else {
+    for (auto it = map.keyframes().rbegin(); it != map.keyframes().rend(); ++it)
+      kfs.push_back(it->first);
+  }
   for (KeyFrameId kf_id : kfs) {
-    const std::vector<LandmarkId> matched =
-        MatchKeyFrameLandmarks(map.keyframe(kf_id), f, kRelocalizationRatio, kThLow);
+    const std::vector<LandmarkId> matched = MatchKeyFrameLandmarks(
+        map.keyframe(kf_id), f, kRelocalizationRatio, kThLow,
+        by_words ? DescriptorSearch::kVocabularyNode : DescriptorSearch::kBruteForce);
     std::vector<size_t> kp_index;
     std::vector<Eigen::Vector3d> pts;
     std::vector<Eigen::Vector2d> px;

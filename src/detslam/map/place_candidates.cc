@@ -1,0 +1,137 @@
+#include "detslam/map/place_candidates.h"
+
+#include <algorithm>
+#include <unordered_map>
+
+namespace detslam {
+namespace {
+
+// Covisibility weight from which two keyframes count as connected (ORB-SLAM's threshold of 15
+// shared map points).
+constexpr int kConnectedMinWeight = 15;
+
+std::set<KeyFrameId> ConnectedGroup(const Map& map, KeyFrameId kf) {
+  std::set<KeyFrameId> group;
+  group.insert(kf);
+  for (const auto& [other, weight] : map.keyframe(kf).covisibility) {
+    if (weight >= kConnectedMinWeight) group.insert(other);
+  }
+  return group;
+}
+
+}  // namespace
+
+std::vector<PlaceCandidate> QueryPlaceCandidates(const Map& map, const BowVector& bow,
+                                                 const PlaceQueryOptions& options) {
+  std::vector<PlaceCandidate> out;
+  KeyFrameDatabase::QueryOptions q;
+  q.min_common_ratio = options.min_common_ratio;
+  q.min_score = options.min_score;
+  if (!options.exclude.empty()) {
+    q.exclude = [&options](KeyFrameDatabase::Id id) { return options.exclude.count(id) > 0; };
+  }
+  const std::vector<KeyFrameDatabase::Result> scored = map.place_index().Query(bow, q);
+  if (scored.empty()) return out;
+  std::unordered_map<KeyFrameId, double> score_of;
+  score_of.reserve(scored.size());
+  for (const auto& r : scored) score_of[r.id] = r.score;
+
+  double best_group = 0.0;
+  std::vector<PlaceCandidate> groups;
+  groups.reserve(scored.size());
+  for (const auto& r : scored) {
+    if (!map.HasKeyFrame(r.id)) continue;
+    PlaceCandidate c{r.id, r.score, r.score};
+    for (KeyFrameId n : map.BestCovisibles(r.id, static_cast<size_t>(options.group_size))) {
+      auto it = score_of.find(n);
+      if (it == score_of.end()) continue;
+      c.group_score += it->second;
+      if (it->second > c.score || (it->second == c.score && n < c.keyframe)) {
+        c.score = it->second;
+        c.keyframe = n;
+      }
+    }
+    best_group = std::max(best_group, c.group_score);
+    groups.push_back(c);
+  }
+  const double min_group = options.min_group_ratio * best_group;
+  std::stable_sort(groups.begin(), groups.end(),
+                   [](const PlaceCandidate& a, const PlaceCandidate& b) {
+                     return a.group_score != b.group_score ? a.group_score > b.group_score
+                                                           : a.keyframe < b.keyframe;
+                   });
+  std::set<KeyFrameId> taken;
+  for (const PlaceCandidate& c : groups) {
+    if (c.group_score <= min_group && c.group_score < best_group) continue;
+    if (!taken.insert(c.keyframe).second) continue;
+    out.push_back(c);
+  }
+  return out;
+}
+
+std::vector<PlaceCandidate> RelocalizationCandidates(const Map& map, const BowVector& bow) {
+  return QueryPlaceCandidates(map, bow, PlaceQueryOptions{});
+}
+
+std::vector<PlaceCandidate> LoopCandidates(const Map& map, KeyFrameId kf,
+                                           const std::set<KeyFrameId>& exclude) {
+  const KeyFrame& query = map.keyframe(kf);
+  const BowVector& bow = query.features->bow;
+  if (bow.empty()) return {};
+  PlaceQueryOptions options;
+  options.exclude = exclude;
+  options.exclude.insert(kf);
+  double min_score = 1.0;
+  bool any_neighbour = false;
+  for (const auto& [other, weight] : query.covisibility) {
+    options.exclude.insert(other);
+    if (weight < kConnectedMinWeight || !map.HasKeyFrame(other)) continue;
+    const BowVector& other_bow = map.keyframe(other).features->bow;
+    if (other_bow.empty()) continue;
+    min_score = std::min(min_score, ScoreL1(bow, other_bow));
+    any_neighbour = true;
+  }
+  options.min_score = any_neighbour ? min_score : 0.0;
+  return QueryPlaceCandidates(map, bow, options);
+}
+
+std::vector<KeyFrameId> LoopConsistency::Update(const Map& map,
+                                                const std::vector<PlaceCandidate>& candidates) {
+  std::vector<KeyFrameId> accepted;
+  if (candidates.empty()) {
+    groups_.clear();
+    return accepted;
+  }
+  std::vector<Group> current;
+  std::vector<bool> continued(groups_.size(), false);
+  for (const PlaceCandidate& c : candidates) {
+    if (!map.HasKeyFrame(c.keyframe)) continue;
+    const std::set<KeyFrameId> members = ConnectedGroup(map, c.keyframe);
+    bool continues_some = false;
+    bool accepted_here = false;
+    for (size_t g = 0; g < groups_.size(); ++g) {
+      const std::set<KeyFrameId>& previous = groups_[g].members;
+      const bool shares = std::any_of(members.begin(), members.end(),
+                                      [&](KeyFrameId id) { return previous.count(id) > 0; });
+      if (!shares) continue;
+      continues_some = true;
+      const int detections = groups_[g].detections + 1;
+      if (!continued[g]) {
+        current.push_back({members, detections});
+        continued[g] = true;
+      }
+      if (detections >= required_ && !accepted_here) {
+        accepted.push_back(c.keyframe);
+        accepted_here = true;
+      }
+    }
+    if (!continues_some) {
+      current.push_back({members, 1});
+      if (required_ <= 1) accepted.push_back(c.keyframe);
+    }
+  }
+  groups_ = std::move(current);
+  return accepted;
+}
+
+}  // namespace detslam

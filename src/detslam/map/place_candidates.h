@@ -1,0 +1,70 @@
+// Place-recognition candidates from the map's bag-of-words index (map.place_index()), with the
+// rules ORB-SLAM2/3 use (Mur-Artal and Tardos): keyframes sharing more than 80% of the most words
+// any keyframe shares with the query are scored; each one's score is accumulated over its 10 best
+// covisible keyframes that are candidates too; groups accumulating more than 75% of the best
+// group's score survive, each represented by its best-scoring keyframe.
+#pragma once
+
+#include <map>
+#include <set>
+#include <vector>
+
+#include "detslam/map/map.h"
+#include "detslam/place/bow_vector.h"
+
+namespace detslam {
+
+struct PlaceCandidate {
+  KeyFrameId keyframe = kNoKeyFrame;  // best-scoring keyframe of its covisibility group
+  double score = 0.0;                 // its own score against the query
+  double group_score = 0.0;           // the group's accumulated score
+};
+
+struct PlaceQueryOptions {
+  double min_common_ratio = 0.8;  // words-in-common pre-filter
+  double min_score = 0.0;         // candidates scoring below this are left out
+  int group_size = 10;            // covisible keyframes accumulated per candidate
+  double min_group_ratio = 0.75;  // of the best group's accumulated score
+  std::set<KeyFrameId> exclude;   // keyframes never returned nor accumulated
+};
+
+// Candidates for `bow` in the map, best group first (ties: lower keyframe id first). Empty when
+// the index is empty or nothing shares a word.
+std::vector<PlaceCandidate> QueryPlaceCandidates(const Map& map, const BowVector& bow,
+                                                 const PlaceQueryOptions& options);
+
+// Relocalisation: candidates for a frame's bag-of-words vector among all keyframes.
+std::vector<PlaceCandidate> RelocalizationCandidates(const Map& map, const BowVector& bow);
+
+// Loop detection for keyframe `kf` (ORB-SLAM2's DetectLoopCandidates): its covisible keyframes and
+// itself are excluded, and the minimum score is the lowest score between `kf` and its covisible
+// keyframes (so a candidate must look at least as similar as the keyframe's own neighbours).
+// `exclude` adds keyframes to leave out (e.g. recent ones).
+std::vector<PlaceCandidate> LoopCandidates(const Map& map, KeyFrameId kf,
+                                           const std::set<KeyFrameId>& exclude = {});
+
+// Loop consistency over consecutive keyframes (after ORB-SLAM2's): a candidate's group (itself
+// and its connected keyframes) continues a group of the previous keyframe's candidates when they
+// share a keyframe; a candidate is accepted once its group has been detected in `required`
+// consecutive keyframes. (ORB-SLAM2 counts continuations and accepts at 3, i.e. on the 4th
+// consecutive detection; our default of 3 detections accepts one keyframe earlier.)
+class LoopConsistency {
+ public:
+  explicit LoopConsistency(int required = 3) : required_(required) {}
+
+  // Updates the consistent groups with this keyframe's candidates and returns those accepted (in
+  // candidate order).
+  std::vector<KeyFrameId> Update(const Map& map, const std::vector<PlaceCandidate>& candidates);
+  // Forgets every group (after a loop was closed, or a keyframe without candidates).
+  void Reset() { groups_.clear(); }
+
+ private:
+  struct Group {
+    std::set<KeyFrameId> members;
+    int detections = 1;  // consecutive keyframes this group was detected in
+  };
+  int required_;
+  std::vector<Group> groups_;
+};
+
+}  // namespace detslam
