@@ -75,12 +75,21 @@ void Tracker::OnLoopClosed(const Map& map, const std::map<KeyFrameId, Rigid3d>& 
   BuildTemporaryPoints(map);
 }
 
-TrackingResult Tracker::Track(Map& map, Frame* frame) {
-  TrackingResult result;
+void Tracker::PrepareFrame(Frame* frame) {
   frame->landmarks.assign(frame->size(), kNoLandmark);
   frame->outlier.assign(frame->size(), false);
   frame->labels.assign(frame->size(), KeypointLabel::kStatic);
   scratch_.Reset(frame->size());
+}
+
+KeyFrameId Tracker::RelocalizeFrame(const Map& map, Frame* frame) {
+  PrepareFrame(frame);
+  return Relocalize(map, frame) ? reference_kf_ : kNoKeyFrame;
+}
+
+TrackingResult Tracker::Track(Map& map, Frame* frame) {
+  TrackingResult result;
+  PrepareFrame(frame);
 
   if (state_ == TrackingState::kNotInitialized) {
     if (Initialize(map, frame)) {

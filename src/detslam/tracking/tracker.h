@@ -66,6 +66,13 @@ class Tracker {
   // close depth (ORB-SLAM's CreateNewKeyFrame for RGB-D). Returns its id.
   KeyFrameId CreateKeyFrame(Map& map, Frame* frame);
 
+  // Relocalisation alone, as Track does it when lost (for benchmarks and tests): bag-of-words
+  // candidates (every keyframe, newest first, when the frame has no bag-of-words vector), matching,
+  // PnP RANSAC and pose optimisation. On success sets frame->cam_from_world and landmarks and
+  // returns the keyframe it relocalised against; else kNoKeyFrame. Changes the tracker's reference
+  // keyframe and local map.
+  KeyFrameId RelocalizeFrame(const Map& map, Frame* frame);
+
   TrackingState state() const { return state_; }
   // Reference keyframe of the last tracked frame.
   KeyFrameId reference_keyframe() const { return reference_kf_; }
@@ -110,6 +117,8 @@ class Tracker {
     void ClearTemporaryMatches();  // track without frame-to-frame points from here on
   };
 
+  // Clears the frame's associations, outlier flags and labels, and the scratch state.
+  void PrepareFrame(Frame* frame);
   bool Initialize(Map& map, Frame* frame);
   bool TrackWithMotionModel(const Map& map, Frame* frame);
   bool TrackReferenceKeyFrame(const Map& map, Frame* frame);
