@@ -302,8 +302,6 @@ void LoopCloser::Correct(Map& map, KeyFrameId kf_id, const Verified& loop,
     lm.position = map.keyframe(ref).cam_from_world.Inverse() * (old_pose.at(ref) * pos);
     map.UpdateLandmarkGeometry(id);
   }
-  if (options_.global_ba_iterations > 0)
-    GlobalBundleAdjustment(camera_, options_.global_ba_iterations, &map);
   result->correction_m =
       (map.keyframe(kf_id).Center() - old_pose.at(kf_id).Inverse().translation()).norm();
   result->old_poses = std::move(old_pose);

@@ -3,8 +3,9 @@
 // 3-D rigid RANSAC on descriptor matches with the keyframe's depth, then pose-only optimisation
 // with more matches by projection), fuse the duplicated landmarks, and distribute the correction
 // over the map by a pose-graph optimisation (spanning tree, strong covisibility edges, loop edges;
-// ORB-SLAM's essential graph), moving every landmark with its reference keyframe, then a bundle
-// adjustment of the whole map.
+// ORB-SLAM's essential graph), moving every landmark with its reference keyframe. The bundle
+// adjustment of the whole map that follows (global_ba_iterations) is the caller's step, outside
+// the map lock (mapping/map_bundle.h GlobalBundleAdjustment).
 //
 // Candidates: with a vocabulary (keyframes carry bag-of-words vectors), by appearance among the
 // keyframes that are neither covisible with the new one nor among its `min_keyframe_gap` newest
@@ -37,7 +38,7 @@ struct LoopClosingOptions {
   int min_verified_inliers = 80;   // pose-only inliers after the projection search
   int essential_min_weight = 100;  // covisibility edges kept in the pose graph
   int global_ba_iterations =
-      10;             // bundle adjustment of the whole map after the pose graph (0: none)
+      10;  // bundle adjustment of the whole map after the pose graph (0: none; run by the caller)
   uint64_t seed = 7;  // RANSAC
   bool Check(std::string* error) const;
 };

@@ -1,6 +1,7 @@
 #include "detslam/mapping/map_bundle.h"
 
 #include <map>
+#include <optional>
 #include <set>
 
 namespace detslam {
@@ -65,20 +66,73 @@ int ApplyMapBundle(const MapBundle& bundle, const BundleSummary& summary, Map* m
   return erased;
 }
 
-BundleSummary GlobalBundleAdjustment(const PinholeCamera& camera, int iterations, Map* map) {
-  std::vector<KeyFrameId> all;
-  for (const auto& [id, kf] : map->keyframes()) {
-    (void)kf;
-    all.push_back(id);
+void PropagateBundleCorrection(const MapBundle& bundle, const std::map<KeyFrameId, Rigid3d>& before,
+                               Map* map) {
+  std::set<KeyFrameId> solved;
+  for (const auto& p : bundle.problem.poses) solved.insert(p.id);
+  std::vector<KeyFrameId> queue;
+  if (map->HasKeyFrame(map->first_keyframe())) queue.push_back(map->first_keyframe());
+  std::set<KeyFrameId> visited(queue.begin(), queue.end());
+  for (size_t q = 0; q < queue.size(); ++q) {
+    const KeyFrameId parent = queue[q];
+    const std::set<KeyFrameId> children = map->keyframe(parent).children;
+    for (KeyFrameId child : children) {
+      if (!map->HasKeyFrame(child) || !visited.insert(child).second) continue;
+      queue.push_back(child);
+      if (solved.count(child)) continue;
+      const Rigid3d child_from_parent = before.at(child) * before.at(parent).Inverse();
+      map->keyframe(child).cam_from_world =
+          child_from_parent * map->keyframe(parent).cam_from_world;
+    }
   }
-  MapBundle b = BuildMapBundle(*map, all, {});
-  BundleSummary s;
-  if (b.problem.poses.empty() || b.problem.observations.empty()) return s;
-  BundleOptions bo;
-  bo.max_iterations = iterations;
-  s = SolveBundle(camera, &b.problem, bo);
-  if (s.usable) ApplyMapBundle(b, s, map);
-  return s;
+  std::set<LandmarkId> held;
+  for (const auto& p : bundle.problem.points) held.insert(p.id);
+  std::vector<LandmarkId> moved;
+  for (auto& [id, lm] : map->landmarks()) {
+    if (held.count(id)) continue;
+    KeyFrameId ref = lm.reference_keyframe;
+    if (!map->HasKeyFrame(ref) && !lm.observations.empty()) ref = lm.observations.begin()->first;
+    if (!map->HasKeyFrame(ref) || !before.count(ref)) continue;
+    moved.push_back(id);
+  }
+  for (LandmarkId id : moved) {
+    Landmark& lm = map->landmark(id);
+    KeyFrameId ref = lm.reference_keyframe;
+    if (!map->HasKeyFrame(ref)) ref = lm.observations.begin()->first;
+    lm.position = map->keyframe(ref).cam_from_world.Inverse() * (before.at(ref) * lm.position);
+    map->UpdateLandmarkGeometry(id);
+  }
+}
+
+BundleSummary GlobalBundleAdjustment(const PinholeCamera& camera, int iterations, MapStore* store,
+                                     const MapUpdatedFn& applied) {
+  BundleSummary summary;
+  auto snapshot = [](const Map& map) -> std::optional<MapBundle> {
+    std::vector<KeyFrameId> all;
+    for (const auto& [id, kf] : map.keyframes()) {
+      (void)kf;
+      all.push_back(id);
+    }
+    MapBundle b = BuildMapBundle(map, all, {});
+    if (b.problem.poses.empty() || b.problem.observations.empty()) return std::nullopt;
+    return b;
+  };
+  auto solve = [&](MapBundle& b) {
+    BundleOptions bo;
+    bo.max_iterations = iterations;
+    summary = SolveBundle(camera, &b.problem, bo);
+    return summary.usable;
+  };
+  auto apply = [&](Map& map, const MapBundle& b, bool usable) {
+    if (!usable) return;
+    std::map<KeyFrameId, Rigid3d> before;
+    for (const auto& [id, kf] : map.keyframes()) before[id] = kf.cam_from_world;
+    ApplyMapBundle(b, summary, &map);
+    PropagateBundleCorrection(b, before, &map);
+    if (applied) applied(map, before);
+  };
+  store->ComputeOutsideLock(snapshot, solve, apply);
+  return summary;
 }
 
 }  // namespace detslam

@@ -3,11 +3,14 @@
 // after loop closing).
 #pragma once
 
+#include <functional>
+#include <map>
 #include <utility>
 #include <vector>
 
 #include "detslam/core/camera.h"
 #include "detslam/map/map.h"
+#include "detslam/map/map_store.h"
 #include "detslam/optim/bundle_adjustment.h"
 
 namespace detslam {
@@ -28,7 +31,22 @@ MapBundle BuildMapBundle(const Map& map, const std::vector<KeyFrameId>& free,
 // are skipped. Returns the number of observations erased.
 int ApplyMapBundle(const MapBundle& bundle, const BundleSummary& summary, Map* map);
 
-// Bundle adjustment of the whole map (first keyframe fixed); returns the solver summary.
-BundleSummary GlobalBundleAdjustment(const PinholeCamera& camera, int iterations, Map* map);
+// After ApplyMapBundle of a bundle built earlier: keyframes the bundle did not hold (created while
+// it was solved) move with their spanning-tree parent, landmarks it did not hold with their
+// reference keyframe (else their first observer). `before`: every keyframe's pose before
+// ApplyMapBundle.
+void PropagateBundleCorrection(const MapBundle& bundle, const std::map<KeyFrameId, Rigid3d>& before,
+                               Map* map);
+
+// Bundle adjustment of the whole map (first keyframe fixed) by the snapshot-solve-apply pattern
+// (MapStore::ComputeOutsideLock): the map as it is now is solved without the lock, so tracking
+// goes on meanwhile; keyframes created meanwhile follow their spanning-tree parent's correction
+// (ORB-SLAM's propagation after its global BA thread) and landmarks created meanwhile their
+// reference keyframe's. `applied` (may be empty) runs under the same lock right after the update,
+// with every keyframe's pose before it (e.g. to move the tracker's last frame). Returns the solver
+// summary (not usable: nothing changed).
+using MapUpdatedFn = std::function<void(Map&, const std::map<KeyFrameId, Rigid3d>& old_poses)>;
+BundleSummary GlobalBundleAdjustment(const PinholeCamera& camera, int iterations, MapStore* store,
+                                     const MapUpdatedFn& applied = nullptr);
 
 }  // namespace detslam

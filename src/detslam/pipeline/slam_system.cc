@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "detslam/core/check.h"
+#include "detslam/mapping/map_bundle.h"
 #include "detslam/place/default_vocabulary.h"
 
 namespace detslam {
@@ -53,15 +54,26 @@ SlamSystem::SlamSystem(const PinholeCamera& camera, const SlamOptions& options,
 void SlamSystem::MapKeyFrame(KeyFrameId kf, FrameReport* report) {
   const auto t0 = std::chrono::steady_clock::now();
   const LocalMappingSummary s = mapper_.ProcessKeyFrame(kf, &store_);
-  const MapStore::WriteAccess map = store_.Write();
-  for (const ErasedKeyFrame& e : s.erased_keyframes) {
-    erased_[e.id] = e;
-    tracker_.OnKeyFrameErased(*map, e.id);
+  bool global_ba = false;
+  {
+    const MapStore::WriteAccess map = store_.Write();
+    for (const ErasedKeyFrame& e : s.erased_keyframes) {
+      erased_[e.id] = e;
+      tracker_.OnKeyFrameErased(*map, e.id);
+    }
+    const LoopClosingResult loop = loop_closer_.Process(*map, kf);
+    if (loop.closed) {
+      tracker_.OnLoopClosed(*map, loop.old_poses);
+      report->loop_closed = true;
+      global_ba = options_.loop.global_ba_iterations > 0;
+    }
   }
-  const LoopClosingResult loop = loop_closer_.Process(*map, kf);
-  if (loop.closed) {
-    tracker_.OnLoopClosed(*map, loop.old_poses);
-    report->loop_closed = true;
+  if (global_ba) {
+    // Without the lock: with a mapping thread, tracking goes on while the whole map is solved.
+    GlobalBundleAdjustment(camera_, options_.loop.global_ba_iterations, &store_,
+                           [this](Map& map, const std::map<KeyFrameId, Rigid3d>& old_poses) {
+                             tracker_.OnLoopClosed(map, old_poses);
+                           });
   }
   report->timings.mapping_ms = MsSince(t0);
   mapping_times_ms_.push_back(report->timings.mapping_ms);
