@@ -13,8 +13,8 @@
 #include "detslam/core/atomic_file.h"
 #include "detslam/io/ply.h"
 #include "detslam/pipeline/bounded_queue.h"
-#include "detslam/pipeline/stage_threads.h"
 #include "detslam/pipeline/settings_keys.h"
+#include "detslam/pipeline/stage_threads.h"
 
 namespace detslam {
 namespace {
@@ -66,6 +66,18 @@ void WriteOutputs(const RgbdDataset& dataset, const Settings& settings, const Ru
   j["map_points"] = summary.landmarks;
   j["relocalizations"] = summary.relocalizations;
   j["loops_closed"] = summary.loops;
+  nlohmann::json loops = nlohmann::json::array();
+  for (const FrameReport& r : summary.reports) {
+    if (!r.loop_closed) continue;
+    loops.push_back({{"frame", r.index},
+                     {"keyframe", r.loop_keyframe},
+                     {"candidate_keyframe", r.loop_candidate},
+                     {"candidate_frame", r.loop_candidate_frame},
+                     {"inliers", r.loop_inliers},
+                     {"correction_m", r.loop_correction_m}});
+  }
+  j["loops"] = loops;
+  j["vocabulary"] = slam.vocabulary_path();
   j["wall_s"] = summary.wall_s;
   j["segmenter"] = summary.segmenter.empty() ? "none" : summary.segmenter;
   const DetSlamOptions& dyn = options.slam.dynamic;
@@ -117,7 +129,8 @@ SlamOptions SlamOptionsFromSettings(const Settings& settings, uint64_t seed) {
   o.orb.min_th_fast = settings.orb.min_th_fast;
   o.tracker.seed = seed;  // relocalisation RANSAC
   o.loop.seed = seed;     // loop verification RANSAC
-  o.tracker.max_frames_between_keyframes = std::max(1, static_cast<int>(std::lround(settings.camera.fps)));
+  o.tracker.max_frames_between_keyframes =
+      std::max(1, static_cast<int>(std::lround(settings.camera.fps)));
   return o;
 }
 

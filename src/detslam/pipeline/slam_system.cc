@@ -40,8 +40,8 @@ SlamSystem::SlamSystem(const PinholeCamera& camera, const SlamOptions& options,
     : camera_(camera),
       options_(options),
       extractor_(options.orb),
-      vocabulary_(options.vocabulary == "none" ? nullptr
-                                               : LoadSharedVocabulary(options.vocabulary)),
+      vocabulary_path_(options.vocabulary.empty() ? DefaultVocabularyPath() : options.vocabulary),
+      vocabulary_(vocabulary_path_ == "none" ? nullptr : LoadSharedVocabulary(vocabulary_path_)),
       dynamic_(options.dynamic, segmenter),
       store_(MakeScaleInfo(extractor_)),
       tracker_(camera, options.tracker, options.dynamic.geometric),
@@ -65,6 +65,11 @@ void SlamSystem::MapKeyFrame(KeyFrameId kf, FrameReport* report) {
     if (loop.closed) {
       tracker_.OnLoopClosed(*map, loop.old_poses);
       report->loop_closed = true;
+      report->loop_keyframe = loop.keyframe;
+      report->loop_candidate = loop.candidate;
+      report->loop_candidate_frame = map->keyframe(loop.candidate).frame_index;
+      report->loop_inliers = loop.inliers;
+      report->loop_correction_m = loop.correction_m;
       global_ba = options_.loop.global_ba_iterations > 0;
     }
   }

@@ -48,6 +48,11 @@ struct FrameReport {
   TrackingResult tracking;
   bool keyframe = false;
   bool loop_closed = false;  // this frame's keyframe closed a loop (mapping in the tracking thread)
+  KeyFrameId loop_keyframe = kNoKeyFrame;   // with loop_closed: the keyframe that closed it
+  KeyFrameId loop_candidate = kNoKeyFrame;  //   the older keyframe of the same place
+  int64_t loop_candidate_frame = -1;        //   and the input frame it was made from
+  int loop_inliers = 0;                     //   verified inliers
+  double loop_correction_m = 0;             //   how far the pose graph moved the keyframe
   int num_keypoints = 0;
   FrameTimings timings;
 };
@@ -100,6 +105,8 @@ class SlamSystem {
   std::vector<double> mapping_times_ms() const;
   // Loops closed so far.
   int loops_closed() const;
+  // The vocabulary file in use ("none" without place recognition).
+  const std::string& vocabulary_path() const { return vocabulary_path_; }
 
  private:
   Rigid3d ReferenceWorldFromCam(const Map& map, KeyFrameId id, const Rigid3d& cam_from_ref) const;
@@ -107,6 +114,7 @@ class SlamSystem {
   PinholeCamera camera_;
   SlamOptions options_;
   OrbExtractor extractor_;
+  std::string vocabulary_path_;
   std::shared_ptr<const Vocabulary> vocabulary_;  // null with vocabulary "none"
   DetSlamStage dynamic_;
   MapStore store_;  // the map's one owner; its lock also guards everything below
