@@ -5,6 +5,10 @@ end drift of a trajectory (the last pose's position error after aligning the fir
 Usage:
   slam_metrics.py field FILE.json key.path        -> prints the value
   slam_metrics.py drift groundtruth.txt trajectory.txt -> prints 'drift_m path_m'
+  slam_metrics.py kidnap run.json groundtruth.txt trajectory.txt FRAME
+      -> prints 'frames_lost reloc_frame error_m': after the jump at input frame FRAME, how many
+         frames went by until a frame was relocalised (-1 -1 -1 if none was), that frame's index and
+         its position error (first poses aligned, as for the drift)
 """
 import json
 import math
@@ -76,7 +80,37 @@ def drift(gt_path, est_path):
     return d, length
 
 
+def position_error_at(gt_path, est_path, stamp):
+    gt = read_tum(gt_path)
+    est = read_tum(est_path)
+
+    def closest(rows, t):
+        return min(rows, key=lambda r: abs(r[0] - t))
+    g0, e0 = closest(gt, est[0][0]), est[0]
+    q = qmul(tuple(g0[4:8]), qinv(tuple(e0[4:8])))
+    t0 = [g0[1 + i] - qrot(q, e0[1:4])[i] for i in range(3)]
+    e = closest(est, stamp)
+    g = closest(gt, stamp)
+    p = [qrot(q, e[1:4])[i] + t0[i] for i in range(3)]
+    return math.dist(p, g[1:4])
+
+
+def kidnap(run_json, gt_path, est_path, jump_frame):
+    with open(run_json) as f:
+        frames = json.load(f)["per_frame"]
+    for r in frames:
+        if r["index"] < jump_frame:
+            continue
+        if r["tracked"] and r["method"] == "relocalization":
+            err = position_error_at(gt_path, est_path, r["stamp"])
+            return r["index"] - jump_frame, r["index"], err
+    return -1, -1, -1
+
+
 def main():
+    if len(sys.argv) == 6 and sys.argv[1] == "kidnap":
+        print("%d %d %.4f" % kidnap(sys.argv[2], sys.argv[3], sys.argv[4], int(sys.argv[5])))
+        return
     if len(sys.argv) == 4 and sys.argv[1] == "field":
         v = get(sys.argv[2], sys.argv[3])
         print(f"{v:.6g}" if isinstance(v, float) else v)
