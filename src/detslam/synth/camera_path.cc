@@ -53,20 +53,21 @@ Rigid3d CameraPath::WorldFromCam(double t) const {
         base + Eigen::Vector3d(Wave(t, 0.42, 10.0, ph[0]) + Wave(t, 0.08, 3.7, ph[1]),
                                Wave(t, 0.30, 13.0, ph[2]) + Wave(t, 0.06, 4.3, ph[3]),
                                Wave(t, 0.28, 8.0, ph[4]) + Wave(t, 0.05, 2.9, ph[5]));
-    const Eigen::Matrix3d r = YawPitchRollRotation(
-        Wave(t, 4 * kDeg, 9.0, ph[6]), 8 * kDeg + Wave(t, 3 * kDeg, 7.0, ph[7]),
-        Wave(t, 2 * kDeg, 6.0, ph[1]));
+    const Eigen::Matrix3d r = YawPitchRollRotation(Wave(t, 4 * kDeg, 9.0, ph[6]),
+                                                   8 * kDeg + Wave(t, 3 * kDeg, 7.0, ph[7]),
+                                                   Wave(t, 2 * kDeg, 6.0, ph[1]));
     return Rigid3d(r, p);
   }
   if (preset_ == "walking_static" || preset_ == "sitting_static") {
     // A hand-held but nearly still camera: millimetres and fractions of a degree.
-    const Eigen::Vector3d b = preset_ == "sitting_static" ? Eigen::Vector3d(0.0, -0.25, 1.25) : base;
+    const Eigen::Vector3d b =
+        preset_ == "sitting_static" ? Eigen::Vector3d(0.0, -0.25, 1.25) : base;
     const Eigen::Vector3d p =
         b + Eigen::Vector3d(Wave(t, 0.008, 3.1, ph[0]) + Wave(t, 0.003, 0.9, ph[1]),
                             Wave(t, 0.006, 4.7, ph[2]), Wave(t, 0.007, 2.3, ph[3]));
-    const Eigen::Matrix3d r = YawPitchRollRotation(
-        Wave(t, 0.6 * kDeg, 5.3, ph[4]), 9 * kDeg + Wave(t, 0.4 * kDeg, 3.7, ph[5]),
-        Wave(t, 0.5 * kDeg, 6.1, ph[6]));
+    const Eigen::Matrix3d r = YawPitchRollRotation(Wave(t, 0.6 * kDeg, 5.3, ph[4]),
+                                                   9 * kDeg + Wave(t, 0.4 * kDeg, 3.7, ph[5]),
+                                                   Wave(t, 0.5 * kDeg, 6.1, ph[6]));
     return Rigid3d(r, p);
   }
   if (preset_ == "walking_rpy") {
@@ -74,9 +75,9 @@ Rigid3d CameraPath::WorldFromCam(double t) const {
     const Eigen::Vector3d p =
         base + Eigen::Vector3d(Wave(t, 0.03, 5.0, ph[0]), Wave(t, 0.03, 6.0, ph[1]),
                                Wave(t, 0.03, 7.0, ph[2]));
-    const Eigen::Matrix3d r = YawPitchRollRotation(
-        Wave(t, 25 * kDeg, 11.0, ph[3]), 8 * kDeg + Wave(t, 15 * kDeg, 9.0, ph[4]),
-        Wave(t, 20 * kDeg, 13.0, ph[5]));
+    const Eigen::Matrix3d r = YawPitchRollRotation(Wave(t, 25 * kDeg, 11.0, ph[3]),
+                                                   8 * kDeg + Wave(t, 15 * kDeg, 9.0, ph[4]),
+                                                   Wave(t, 20 * kDeg, 13.0, ph[5]));
     return Rigid3d(r, p);
   }
   if (preset_ == "walking_halfsphere") {
@@ -101,8 +102,8 @@ Rigid3d CameraPath::WorldFromCam(double t) const {
   const Eigen::Vector2d outward = Eigen::Vector2d(b * std::sin(th), -a * std::cos(th)).normalized();
   const Eigen::Vector2d look = std::cos(40 * kDeg) * tangent + std::sin(40 * kDeg) * outward;
   const double yaw = std::atan2(-look.x(), look.y());
-  const Eigen::Matrix3d r =
-      YawPitchRollRotation(yaw, 6 * kDeg + 2 * kDeg * std::sin(2 * th), 1.5 * kDeg * std::sin(5 * th));
+  const Eigen::Matrix3d r = YawPitchRollRotation(yaw, 6 * kDeg + 2 * kDeg * std::sin(2 * th),
+                                                 1.5 * kDeg * std::sin(5 * th));
   return Rigid3d(r, p);
 }
 

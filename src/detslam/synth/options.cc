@@ -9,7 +9,7 @@ namespace detslam {
 
 const std::vector<std::string>& SynthPresetNames() {
   static const std::vector<std::string> kNames = {
-      "static", "walking_xyz", "walking_static", "walking_rpy", "walking_halfsphere",
+      "static",         "walking_xyz", "walking_static", "walking_rpy", "walking_halfsphere",
       "sitting_static", "loop"};
   return kNames;
 }

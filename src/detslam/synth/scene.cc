@@ -15,7 +15,8 @@ class SceneBuilder {
   // Adds a box whose faces use `sides` texture, the top (+z) face `top`; `special_face` (if >= 0)
   // uses `special`.
   void Box(Eigen::Vector3f lo, Eigen::Vector3f hi, SurfaceKind sides, SurfaceKind top,
-           int special_face = -1, SurfaceKind special = SurfaceKind::kPoster, bool interior = false) {
+           int special_face = -1, SurfaceKind special = SurfaceKind::kPoster,
+           bool interior = false) {
     SceneBox b;
     b.lo = lo;
     b.hi = hi;
@@ -89,13 +90,16 @@ Scene BuildOfficeScene(uint64_t seed) {
   b.Desk(-1.3f, 1.3f, 0.6f, 1.9f, true);
   b.Monitor(-1.0f, 1.2f, 0.755f, true);
   b.Monitor(1.0f, 1.2f, 0.755f, true);
-  b.Box(V(-0.35f, 0.75f, 0.755f), V(0.15f, 0.92f, 0.78f), SurfaceKind::kMetal, SurfaceKind::kScreen);
+  b.Box(V(-0.35f, 0.75f, 0.755f), V(0.15f, 0.92f, 0.78f), SurfaceKind::kMetal,
+        SurfaceKind::kScreen);
   b.Box(V(0.3f, 0.7f, 0.755f), V(0.62f, 1.0f, 0.765f), SurfaceKind::kPoster, SurfaceKind::kPoster);
-  b.Box(V(-0.7f, 0.8f, 0.755f), V(-0.6f, 0.9f, 0.87f), SurfaceKind::kCardboard, SurfaceKind::kMetal);
+  b.Box(V(-0.7f, 0.8f, 0.755f), V(-0.6f, 0.9f, 0.87f), SurfaceKind::kCardboard,
+        SurfaceKind::kMetal);
   // Side desk along the left wall with a monitor and boxes below.
   b.Desk(-3.0f, -2.25f, -1.6f, 0.9f, false);
   b.Monitor(-2.85f, -0.4f, 0.755f, false);
-  b.Box(V(-2.9f, 0.1f, 0.0f), V(-2.4f, 0.6f, 0.42f), SurfaceKind::kCardboard, SurfaceKind::kCardboard);
+  b.Box(V(-2.9f, 0.1f, 0.0f), V(-2.4f, 0.6f, 0.42f), SurfaceKind::kCardboard,
+        SurfaceKind::kCardboard);
   b.Box(V(-2.9f, -1.4f, 0.755f), V(-2.55f, -1.0f, 0.95f), SurfaceKind::kCardboard,
         SurfaceKind::kCardboard);
   // Far wall: two shelves full of books and posters between them.
@@ -103,24 +107,31 @@ Scene BuildOfficeScene(uint64_t seed) {
         FaceIndex(1, false), SurfaceKind::kBooks);
   b.Box(V(1.45f, 2.25f, 0.0f), V(2.8f, 2.6f, 1.75f), SurfaceKind::kWood, SurfaceKind::kCardboard,
         FaceIndex(1, false), SurfaceKind::kBooks);
-  b.Box(V(-1.0f, 2.57f, 1.3f), V(0.15f, 2.6f, 2.15f), W, W, FaceIndex(1, false), SurfaceKind::kPoster);
-  b.Box(V(0.35f, 2.57f, 1.05f), V(1.15f, 2.6f, 1.95f), W, W, FaceIndex(1, false), SurfaceKind::kPoster);
+  b.Box(V(-1.0f, 2.57f, 1.3f), V(0.15f, 2.6f, 2.15f), W, W, FaceIndex(1, false),
+        SurfaceKind::kPoster);
+  b.Box(V(0.35f, 2.57f, 1.05f), V(1.15f, 2.6f, 1.95f), W, W, FaceIndex(1, false),
+        SurfaceKind::kPoster);
   // Right wall: cabinet, whiteboard, stacked boxes, a door.
   b.Box(V(2.5f, -1.0f, 0.0f), V(3.0f, 0.2f, 1.1f), SurfaceKind::kMetal, SurfaceKind::kWood);
   b.Box(V(2.97f, 0.4f, 0.9f), V(3.0f, 2.0f, 2.0f), W, W, FaceIndex(0, false), SurfaceKind::kPoster);
   b.Box(V(2.2f, 1.0f, 0.0f), V(2.8f, 1.6f, 0.5f), SurfaceKind::kCardboard, SurfaceKind::kCardboard);
-  b.Box(V(2.3f, 1.1f, 0.5f), V(2.7f, 1.5f, 0.82f), SurfaceKind::kCardboard, SurfaceKind::kCardboard);
+  b.Box(V(2.3f, 1.1f, 0.5f), V(2.7f, 1.5f, 0.82f), SurfaceKind::kCardboard,
+        SurfaceKind::kCardboard);
   b.Box(V(2.96f, -2.3f, 0.0f), V(3.0f, -1.4f, 2.1f), SurfaceKind::kWood, SurfaceKind::kWood,
         FaceIndex(0, false), SurfaceKind::kWood);
   // Back wall (behind the default camera): shelf, posters, boxes.
   b.Box(V(-1.1f, -2.8f, 0.0f), V(0.9f, -2.42f, 1.9f), SurfaceKind::kWood, SurfaceKind::kWood,
         FaceIndex(1, true), SurfaceKind::kBooks);
-  b.Box(V(1.3f, -2.8f, 1.0f), V(2.3f, -2.77f, 1.9f), W, W, FaceIndex(1, true), SurfaceKind::kPoster);
-  b.Box(V(-2.6f, -2.8f, 0.0f), V(-1.9f, -2.2f, 0.6f), SurfaceKind::kCardboard, SurfaceKind::kCardboard);
+  b.Box(V(1.3f, -2.8f, 1.0f), V(2.3f, -2.77f, 1.9f), W, W, FaceIndex(1, true),
+        SurfaceKind::kPoster);
+  b.Box(V(-2.6f, -2.8f, 0.0f), V(-1.9f, -2.2f, 0.6f), SurfaceKind::kCardboard,
+        SurfaceKind::kCardboard);
   b.Box(V(1.6f, -2.6f, 0.0f), V(2.2f, -2.1f, 0.75f), SurfaceKind::kMetal, SurfaceKind::kWood);
   // Left wall posters.
-  b.Box(V(-3.0f, 1.2f, 1.2f), V(-2.97f, 2.1f, 2.05f), W, W, FaceIndex(0, true), SurfaceKind::kPoster);
-  b.Box(V(-3.0f, -2.5f, 1.3f), V(-2.97f, -1.8f, 2.0f), W, W, FaceIndex(0, true), SurfaceKind::kPoster);
+  b.Box(V(-3.0f, 1.2f, 1.2f), V(-2.97f, 2.1f, 2.05f), W, W, FaceIndex(0, true),
+        SurfaceKind::kPoster);
+  b.Box(V(-3.0f, -2.5f, 1.3f), V(-2.97f, -1.8f, 2.0f), W, W, FaceIndex(0, true),
+        SurfaceKind::kPoster);
   return b.Take();
 }
 

@@ -18,17 +18,17 @@ namespace detslam::synth {
 inline int FaceIndex(int axis, bool hi_side) { return 2 * axis + (hi_side ? 1 : 0); }
 
 struct SceneBox {
-  Eigen::Vector3f lo;                // minimum corner (metres, world)
-  Eigen::Vector3f hi;                // maximum corner (metres, world)
-  bool interior = false;             // true for the room shell, which is seen from inside
-  std::array<int, 6> texture{};      // index into Scene::textures for each face (FaceIndex)
+  Eigen::Vector3f lo;            // minimum corner (metres, world)
+  Eigen::Vector3f hi;            // maximum corner (metres, world)
+  bool interior = false;         // true for the room shell, which is seen from inside
+  std::array<int, 6> texture{};  // index into Scene::textures for each face (FaceIndex)
 };
 
 struct Scene {
-  std::vector<SceneBox> boxes;       // boxes[0] is the room shell
-  std::vector<cv::Mat> textures;     // CV_8UC3, kTexelsPerMetre texels per metre
+  std::vector<SceneBox> boxes;            // boxes[0] is the room shell
+  std::vector<cv::Mat> textures;          // CV_8UC3, kTexelsPerMetre texels per metre
   Eigen::Vector3f light{0.f, 0.f, 2.6f};  // point light position (world)
-  float ambient = 0.45f;             // ambient share of the shading
+  float ambient = 0.45f;                  // ambient share of the shading
 };
 
 // Texture coordinates (texels) of world point `p` on face (axis, hi_side) of `box`: column from

@@ -93,7 +93,8 @@ SynthFrame SyntheticSequence::Render(int k) const {
     // Image motion during a 1/60 s exposure of the point at the median depth on the optical axis
     // (a global linear blur along the camera's image-plane velocity).
     const double exposure = 1.0 / 60.0;
-    const Rigid3d a = path_.WorldFromCam(t - 0.5 * exposure), b = path_.WorldFromCam(t + 0.5 * exposure);
+    const Rigid3d a = path_.WorldFromCam(t - 0.5 * exposure),
+                  b = path_.WorldFromCam(t + 0.5 * exposure);
     std::vector<float> z(ideal.depth.begin<float>(), ideal.depth.end<float>());
     std::nth_element(z.begin(), z.begin() + z.size() / 2, z.end());
     const double zm = std::max(0.5f, z[z.size() / 2]);
@@ -104,8 +105,8 @@ SynthFrame SyntheticSequence::Render(int k) const {
                                                static_cast<float>(uv_b.y() - uv_a.y())));
   }
   if (options_.sensor_noise) synth::AddColourNoise(&f.bgr, sensor_, options_.seed, k);
-  f.depth16 = synth::MakeDepth16(ideal.depth, camera_, sensor_, options_.seed, k,
-                                 options_.sensor_noise);
+  f.depth16 =
+      synth::MakeDepth16(ideal.depth, camera_, sensor_, options_.seed, k, options_.sensor_noise);
   // Instances: bounding boxes of the visible mask pixels.
   std::map<int, SynthInstance> found;
   for (int v = 0; v < f.instance_mask.rows; ++v) {

@@ -67,18 +67,21 @@ SynthStats WriteSequence(const SynthOptions& options, const std::string& out_dir
   std::error_code ec;
   for (const char* sub : {"rgb", "depth", "masks"}) {
     fs::create_directories(fs::path(out_dir) / sub, ec);
-    if (ec) throw InputError(out_dir, 0, std::string("cannot create folder ") + sub + ": " + ec.message());
+    if (ec)
+      throw InputError(out_dir, 0,
+                       std::string("cannot create folder ") + sub + ": " + ec.message());
   }
   const std::string header = Describe(options);
   std::ostringstream rgb_txt, depth_txt, inst_txt;
   rgb_txt << "# color images\n# file: '" << header << "'\n# timestamp filename\n";
   depth_txt << "# depth maps\n# file: '" << header << "'\n# timestamp filename\n";
-  inst_txt << "# moving-object instances per frame (ground truth of the synthetic sequence)\n"
-           << "# file: '" << header << "'\n"
-           << "# timestamp id class score x y w h\n"
-           << "# timestamp: colour image stamp; id: value of the object's pixels in\n"
-           << "# masks/<timestamp>.png (16-bit, 0 = static scene); class: COCO name; score: 1 (truth);\n"
-           << "# x y w h: bounding box of the visible pixels (pixels, top-left origin)\n";
+  inst_txt
+      << "# moving-object instances per frame (ground truth of the synthetic sequence)\n"
+      << "# file: '" << header << "'\n"
+      << "# timestamp id class score x y w h\n"
+      << "# timestamp: colour image stamp; id: value of the object's pixels in\n"
+      << "# masks/<timestamp>.png (16-bit, 0 = static scene); class: COCO name; score: 1 (truth);\n"
+      << "# x y w h: bounding box of the visible pixels (pixels, top-left origin)\n";
   Trajectory gt;
   SynthStats stats;
   stats.frames = seq.size();
@@ -95,7 +98,8 @@ SynthStats WriteSequence(const SynthOptions& options, const std::string& out_dir
     cv::parallel_for_(cv::Range(0, 3), [&](const cv::Range& r) {
       for (int i = r.start; i < r.end; ++i) bytes[i] = EncodePng(*images[i], names[i]);
     });
-    for (int i = 0; i < 3; ++i) WriteBytesAtomically((fs::path(out_dir) / names[i]).string(), bytes[i]);
+    for (int i = 0; i < 3; ++i)
+      WriteBytesAtomically((fs::path(out_dir) / names[i]).string(), bytes[i]);
     rgb_txt << stamp << " " << names[0] << "\n";
     depth_txt << dstamp << " " << names[1] << "\n";
     for (const SynthInstance& in : f.instances) {
@@ -117,15 +121,13 @@ SynthStats WriteSequence(const SynthOptions& options, const std::string& out_dir
     }
   }
   auto write_text = [&](const std::string& name, const std::string& text) {
-    WriteFileAtomically((fs::path(out_dir) / name).string(),
-                        [&](std::ostream& os) { os << text; });
+    WriteFileAtomically((fs::path(out_dir) / name).string(), [&](std::ostream& os) { os << text; });
   };
   write_text("rgb.txt", rgb_txt.str());
   write_text("depth.txt", depth_txt.str());
   write_text("masks/instances.txt", inst_txt.str());
   WriteTumTrajectory((fs::path(out_dir) / "groundtruth.txt").string(), gt,
-                     "ground truth trajectory (world_from_camera)\nfile: '" + header +
-                         "'");
+                     "ground truth trajectory (world_from_camera)\nfile: '" + header + "'");
   WriteSynthSettings((fs::path(out_dir) / "settings.yaml").string(), seq.camera());
   stats.total_seconds += Since(start);
   stats.render_fps = stats.frames / std::max(1e-9, stats.render_seconds);

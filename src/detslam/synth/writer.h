@@ -14,14 +14,14 @@ namespace detslam {
 
 // What writing a sequence measured.
 struct SynthStats {
-  int frames = 0;                  // frames written
-  double render_seconds = 0;       // time spent rendering (scene, people, sensor effects)
-  double total_seconds = 0;        // rendering + PNG encoding + writing files
-  double render_fps = 0;           // frames / render_seconds
-  double total_fps = 0;            // frames / total_seconds
-  double mean_fast_corners = 0;    // mean cv::FAST (threshold 20, non-max) corners, sampled frames
-  double mean_coverage = 0;        // mean fraction of pixels covered by people, all frames
-  int sampled_frames = 0;          // frames the FAST count was taken on
+  int frames = 0;                // frames written
+  double render_seconds = 0;     // time spent rendering (scene, people, sensor effects)
+  double total_seconds = 0;      // rendering + PNG encoding + writing files
+  double render_fps = 0;         // frames / render_seconds
+  double total_fps = 0;          // frames / total_seconds
+  double mean_fast_corners = 0;  // mean cv::FAST (threshold 20, non-max) corners, sampled frames
+  double mean_coverage = 0;      // mean fraction of pixels covered by people, all frames
+  int sampled_frames = 0;        // frames the FAST count was taken on
 };
 
 // Renders and writes the sequence into `out_dir` (created if missing; existing files of the same
