@@ -75,6 +75,10 @@ Rigid3d SyntheticSequence::WorldFromCam(int k) const {
   return path_.WorldFromCam(static_cast<double>(k) / camera_.fps);
 }
 
+double SyntheticSequence::DepthScaleOf(int k) const {
+  return SynthDepthScale(options_.depth_scale_bias, k, frames_);
+}
+
 SynthFrame SyntheticSequence::Render(int k) const {
   DETSLAM_CHECK_MSG(k >= 0 && k < frames_, "frame " << k << " out of range 0.." << frames_ - 1);
   const double t = static_cast<double>(k) / camera_.fps;
@@ -105,8 +109,11 @@ SynthFrame SyntheticSequence::Render(int k) const {
                                                static_cast<float>(uv_b.y() - uv_a.y())));
   }
   if (options_.sensor_noise) synth::AddColourNoise(&f.bgr, sensor_, options_.seed, k);
-  f.depth16 =
-      synth::MakeDepth16(ideal.depth, camera_, sensor_, options_.seed, k, options_.sensor_noise);
+  // A miscalibrated sensor (--depth-scale-bias): every depth it measures is `scale` x the truth.
+  // true_depth and the pose stay true.
+  const double scale = DepthScaleOf(k);
+  const cv::Mat sensed = scale == 1.0 ? ideal.depth : cv::Mat(ideal.depth * scale);
+  f.depth16 = synth::MakeDepth16(sensed, camera_, sensor_, options_.seed, k, options_.sensor_noise);
   // Instances: bounding boxes of the visible mask pixels.
   std::map<int, SynthInstance> found;
   for (int v = 0; v < f.instance_mask.rows; ++v) {

@@ -58,6 +58,8 @@ class SyntheticSequence {
   Timestamp StampOf(int k) const;
   Timestamp DepthStampOf(int k) const;
   Rigid3d WorldFromCam(int k) const;
+  // Factor the written depth of frame k is multiplied by (options.depth_scale_bias; 1 if off).
+  double DepthScaleOf(int k) const;
 
   // Renders frame k (0 <= k < size()); thread-safe, deterministic.
   SynthFrame Render(int k) const;

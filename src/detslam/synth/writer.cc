@@ -39,6 +39,8 @@ std::string Describe(const SynthOptions& o) {
   if (!o.people) os << " --no-people";
   if (!o.people_dir.empty()) os << " --people " << o.people_dir;
   if (o.motion_blur) os << " --blur";
+  if (o.depth_scale_bias != 0.0) os << " --depth-scale-bias " << o.depth_scale_bias;
+  if (o.HasCut()) os << " --cut " << o.cut_begin << ":" << o.cut_end;
   return os.str();
 }
 
@@ -84,9 +86,11 @@ SynthStats WriteSequence(const SynthOptions& options, const std::string& out_dir
       << "# x y w h: bounding box of the visible pixels (pixels, top-left origin)\n";
   Trajectory gt;
   SynthStats stats;
-  stats.frames = seq.size();
   double coverage_sum = 0, fast_sum = 0;
   for (int k = 0; k < seq.size(); ++k) {
+    // --cut: the camera keeps moving through the cut frames, none of their files are written.
+    if (options.HasCut() && k >= options.cut_begin && k < options.cut_end) continue;
+    ++stats.frames;
     const auto t0 = Clock::now();
     const SynthFrame f = seq.Render(k);
     stats.render_seconds += Since(t0);
@@ -117,7 +121,7 @@ SynthStats WriteSequence(const SynthOptions& options, const std::string& out_dir
     stats.total_seconds -= measure;  // statistics are not part of the generator's speed
     if ((k + 1) % 50 == 0 || k + 1 == seq.size()) {
       spdlog::info("synth {}: frame {}/{} ({:.1f} fps)", options.preset, k + 1, seq.size(),
-                   (k + 1) / std::max(1e-9, Since(start) + stats.total_seconds));
+                   stats.frames / std::max(1e-9, Since(start) + stats.total_seconds));
     }
   }
   auto write_text = [&](const std::string& name, const std::string& text) {

@@ -2,7 +2,9 @@
 //   rgb/<stamp>.png  depth/<stamp>.png (16-bit, metres * 5000, 0 = missing)  rgb.txt depth.txt
 //   groundtruth.txt (TUM, world_from_camera per frame)  masks/<stamp>.png (16-bit instance ids)
 //   masks/instances.txt  settings.yaml (ORB-SLAM3 v1.0 style, TUM fr3 camera)
-// Every file is written atomically; the same options give byte-identical files.
+// Every file is written atomically; the same options give byte-identical files. With a cut
+// (options.cut_begin/cut_end) the cut frames are absent from every file and folder (the rest keep
+// their true stamps and poses: a gap in time, a jump in pose).
 #pragma once
 
 #include <opencv2/core.hpp>

@@ -1,0 +1,256 @@
+// The generator's options for place-recognition sequences: a depth-scale drift
+// (--depth-scale-bias) and a kidnapped camera (--cut).
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <opencv2/imgproc.hpp>
+#include <sstream>
+
+#include "detslam/core/check.h"
+#include "detslam/io/trajectory.h"
+#include "detslam/synth/sequence.h"
+#include "detslam/synth/writer.h"
+
+namespace detslam {
+namespace {
+
+namespace fs = std::filesystem;
+
+SynthOptions Opts(const std::string& preset, uint64_t seed = 1, bool noise = true) {
+  SynthOptions o;
+  o.preset = preset;
+  o.seed = seed;
+  o.sensor_noise = noise;
+  return o;
+}
+
+std::string Slurp(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::ostringstream os;
+  os << in.rdbuf();
+  return os.str();
+}
+
+fs::path TempDir(const std::string& name) {
+  const fs::path dir = fs::temp_directory_path() /
+                       ("detslam_synth_place_" + name + "_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  return dir;
+}
+
+// The error message of Check, or "" if the options are valid.
+std::string CheckError(const SynthOptions& o) {
+  std::string error;
+  return o.Check(&error) ? "" : error;
+}
+
+// The InputError message `f` throws ("" if it throws nothing).
+template <typename F>
+std::string InputErrorOf(F f) {
+  try {
+    f();
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+// --- options -------------------------------------------------------------------------------------
+
+TEST(SynthPlaceOptionsTest, BadDepthScaleBiasNamesTheOption) {
+  for (double bad : {0.6, -0.51, std::numeric_limits<double>::quiet_NaN(),
+                     std::numeric_limits<double>::infinity()}) {
+    SynthOptions o = Opts("loop");
+    o.depth_scale_bias = bad;
+    EXPECT_NE(CheckError(o).find("--depth-scale-bias"), std::string::npos) << bad;
+    EXPECT_NE(InputErrorOf([&] { SyntheticSequence seq(o); }).find("--depth-scale-bias"),
+              std::string::npos);
+  }
+  for (double good : {0.0, 0.3, -0.2, 0.5}) {
+    SynthOptions o = Opts("loop");
+    o.depth_scale_bias = good;
+    EXPECT_EQ(CheckError(o), "") << good;
+  }
+}
+
+TEST(SynthPlaceOptionsTest, CutParsesAndBadCutsNameTheOption) {
+  SynthOptions o = Opts("loop");
+  o.frames = 1050;
+  ParseSynthCut("300:900", &o);
+  EXPECT_EQ(o.cut_begin, 300);
+  EXPECT_EQ(o.cut_end, 900);
+  EXPECT_TRUE(o.HasCut());
+  EXPECT_EQ(CheckError(o), "");
+  for (const std::string bad : {"", "300", "300:", ":900", "900:300", "5:5", "a:b", "-1:5", "1:2:3",
+                                "1.5:9", " 1:9", "99999999999:100000000000"}) {
+    const std::string error = InputErrorOf([&] { ParseSynthCut(bad, &o); });
+    EXPECT_NE(error.find("--cut"), std::string::npos) << "'" << bad << "': " << error;
+  }
+  // Inside the sequence, at least one frame on each side: 1 <= A < B <= frames - 1.
+  o.frames = 100;
+  for (const auto& [a, b] : std::vector<std::pair<int, int>>{{0, 10}, {50, 100}, {90, 200}}) {
+    o.cut_begin = a;
+    o.cut_end = b;
+    EXPECT_NE(CheckError(o).find("--cut"), std::string::npos) << a << ":" << b;
+    EXPECT_NE(CheckError(o).find("99"), std::string::npos) << CheckError(o);
+    EXPECT_NE(InputErrorOf([&] { SyntheticSequence seq(o); }).find("--cut"), std::string::npos);
+  }
+  o.cut_begin = 1;
+  o.cut_end = 99;
+  EXPECT_EQ(CheckError(o), "");
+  o.frames = -1;  // the preset's 900 frames
+  o.cut_end = 900;
+  EXPECT_NE(CheckError(o).find("--cut"), std::string::npos);
+  o.cut_end = 899;
+  EXPECT_EQ(CheckError(o), "");
+  o.preset = "no_such_preset";  // the frame count is unknown: only A < B is checked here
+  EXPECT_EQ(CheckError(o).find("--cut"), std::string::npos);
+  o.cut_end = 0;
+  EXPECT_NE(CheckError(o).find("--cut"), std::string::npos);
+}
+
+// --- depth scale drift -----------------------------------------------------------------------
+
+TEST(SynthDepthScaleTest, RampsFromOneToOnePlusBiasAndBack) {
+  const int n = 901;
+  EXPECT_EQ(SynthDepthScale(0.0, 450, n), 1.0);
+  EXPECT_DOUBLE_EQ(SynthDepthScale(0.3, 0, n), 1.0);
+  EXPECT_NEAR(SynthDepthScale(0.3, n - 1, n), 1.0, 1e-15);
+  EXPECT_DOUBLE_EQ(SynthDepthScale(0.3, 450, n), 1.3);
+  EXPECT_NEAR(SynthDepthScale(0.3, 225, n), 1.15, 1e-12);  // sin^2(pi / 4) = 1/2
+  for (int k = 1; k <= 450; ++k)
+    EXPECT_GT(SynthDepthScale(0.3, k, n), SynthDepthScale(0.3, k - 1, n));
+  for (int k = 451; k < n; ++k)
+    EXPECT_LT(SynthDepthScale(0.3, k, n), SynthDepthScale(0.3, k - 1, n));
+}
+
+TEST(SynthDepthScaleTest, ScalesTheWrittenDepthOnly) {
+  SynthOptions biased = Opts("loop", 2, /*noise=*/false);
+  biased.frames = 61;
+  biased.depth_scale_bias = 0.3;
+  SynthOptions plain = biased;
+  plain.depth_scale_bias = 0.0;
+  SyntheticSequence a(biased), b(plain);
+  for (int k : {0, 15, 30, 60}) {
+    const SynthFrame fa = a.Render(k), fb = b.Render(k);
+    const double scale = a.DepthScaleOf(k);
+    EXPECT_DOUBLE_EQ(scale, SynthDepthScale(0.3, k, 61));
+    EXPECT_EQ(b.DepthScaleOf(k), 1.0);
+    // Pose, colour, masks and the true depth are those of the unbiased sequence.
+    EXPECT_TRUE(fa.world_from_cam.Matrix().isApprox(fb.world_from_cam.Matrix(), 0.0));
+    EXPECT_EQ(cv::norm(fa.bgr, fb.bgr, cv::NORM_INF), 0.0);
+    EXPECT_EQ(cv::norm(fa.true_depth, fb.true_depth, cv::NORM_INF), 0.0);
+    int checked = 0;
+    for (int v = 0; v < fa.depth16.rows; v += 7) {
+      for (int u = 0; u < fa.depth16.cols; u += 7) {
+        const uint16_t raw = fa.depth16.at<uint16_t>(v, u);
+        if (raw == 0) continue;
+        EXPECT_NEAR(raw / 5000.0, scale * fa.true_depth.at<float>(v, u), 1.5e-4);
+        ++checked;
+      }
+    }
+    EXPECT_GT(checked, 3000);
+  }
+  EXPECT_DOUBLE_EQ(a.DepthScaleOf(30), 1.3);
+}
+
+// --- kidnapped camera ------------------------------------------------------------------------
+
+TEST(SynthCutTest, CutFramesAreAbsentFromEveryFileAndTheRestUnchanged) {
+  SynthOptions o = Opts("walking_xyz", 4);
+  o.frames = 9;
+  SynthOptions cut = o;
+  ParseSynthCut("3:7", &cut);
+  const fs::path full_dir = TempDir("full"), cut_dir = TempDir("cut");
+  WriteSequence(o, full_dir.string());
+  const SynthStats stats = WriteSequence(cut, cut_dir.string());
+  EXPECT_EQ(stats.frames, 5);
+  SyntheticSequence seq(o);
+  const std::vector<int> kept = {0, 1, 2, 7, 8};
+  // Ground truth: the kept frames' true stamps and poses (a 4/30 s gap, a jump in pose).
+  const Trajectory gt = ReadTumTrajectory((cut_dir / "groundtruth.txt").string());
+  ASSERT_EQ(gt.size(), kept.size());
+  for (size_t i = 0; i < kept.size(); ++i) {
+    EXPECT_EQ(gt[i].stamp, seq.StampOf(kept[i]));
+    EXPECT_TRUE(gt[i].world_from_cam.Matrix().isApprox(seq.WorldFromCam(kept[i]).Matrix(), 1e-8));
+  }
+  // Every per-frame file of a kept frame is the uncut run's; nothing of a cut frame exists.
+  int files = 0;
+  for (const auto& entry : fs::recursive_directory_iterator(cut_dir)) {
+    if (!entry.is_regular_file() || entry.path().extension() != ".png") continue;
+    EXPECT_EQ(Slurp(entry.path()), Slurp(full_dir / fs::relative(entry.path(), cut_dir)));
+    ++files;
+  }
+  EXPECT_EQ(files, 3 * 5);
+  for (int k = 3; k < 7; ++k) {
+    const std::string stamp = seq.StampOf(k).ToString();
+    EXPECT_FALSE(fs::exists(cut_dir / "rgb" / (stamp + ".png")));
+    EXPECT_FALSE(fs::exists(cut_dir / "masks" / (stamp + ".png")));
+    EXPECT_FALSE(fs::exists(cut_dir / "depth" / (seq.DepthStampOf(k).ToString() + ".png")));
+    for (const char* list : {"rgb.txt", "depth.txt", "masks/instances.txt"}) {
+      EXPECT_EQ(Slurp(cut_dir / list).find(stamp), std::string::npos) << list << " " << k;
+    }
+  }
+  for (int k : kept) {
+    EXPECT_NE(Slurp(cut_dir / "rgb.txt").find(seq.StampOf(k).ToString()), std::string::npos);
+    EXPECT_NE(Slurp(cut_dir / "depth.txt").find(seq.DepthStampOf(k).ToString()), std::string::npos);
+  }
+  EXPECT_NE(Slurp(cut_dir / "rgb.txt").find("--cut 3:7"), std::string::npos);
+  fs::remove_all(full_dir);
+  fs::remove_all(cut_dir);
+}
+
+// Fraction of frame `target`'s pixels (a grid) that some frame in [0, before) saw (projects inside
+// its image at the depth it measured there).
+double SeenBefore(const SyntheticSequence& seq, int target, int before, int step) {
+  const PinholeCamera cam = seq.camera();
+  const SynthFrame t = seq.Render(target);
+  std::vector<Eigen::Vector3d> points;
+  for (int v = 8; v < cam.height; v += 16) {
+    for (int u = 8; u < cam.width; u += 16) {
+      const float z = t.true_depth.at<float>(v, u);
+      if (z > 0) points.push_back(t.world_from_cam * cam.Unproject(Eigen::Vector2d(u, v), z));
+    }
+  }
+  std::vector<bool> seen(points.size(), false);
+  for (int k = 0; k < before; k += step) {
+    const SynthFrame f = seq.Render(k);
+    const Rigid3d cam_from_world = f.world_from_cam.Inverse();
+    for (size_t i = 0; i < points.size(); ++i) {
+      const Eigen::Vector3d p = cam_from_world * points[i];
+      if (seen[i] || p.z() < 0.1) continue;
+      const Eigen::Vector2d uv = cam.Project(p);
+      const int u = static_cast<int>(std::lround(uv.x())),
+                v = static_cast<int>(std::lround(uv.y()));
+      if (u < 0 || v < 0 || u >= cam.width || v >= cam.height) continue;
+      seen[i] = std::abs(f.true_depth.at<float>(v, u) - p.z()) < 0.03;
+    }
+  }
+  return static_cast<double>(std::count(seen.begin(), seen.end(), true)) / points.size();
+}
+
+TEST(SynthCutTest, RecommendedKidnapLandsOnMappedPlaceFromAnotherViewpoint) {
+  // README: detslam synth --preset walking_halfsphere --seed 1 --cut 150:510. The camera maps the
+  // table from one stretch of the half-sphere for 5 s, then jumps 12 s ahead to another.
+  SyntheticSequence seq(Opts("walking_halfsphere", 1, false));
+  const int a = 150, b = 510;
+  const Rigid3d landing = seq.WorldFromCam(b);
+  double nearest = 1e9, nearest_angle = 1e9;
+  for (int k = 0; k < a; ++k) {
+    const Rigid3d rel = seq.WorldFromCam(k).Inverse() * landing;
+    nearest = std::min(nearest, rel.translation().norm());
+    nearest_angle = std::min(nearest_angle, rel.RotationAngle() * 180.0 / M_PI);
+  }
+  EXPECT_GT(nearest, 0.5);         // metres from every pose before the cut
+  EXPECT_GT(nearest_angle, 10.0);  // degrees
+  EXPECT_GT((seq.WorldFromCam(a - 1).translation() - landing.translation()).norm(), 0.5);
+  // Most of what it sees after the jump was seen (mapped) before the cut.
+  EXPECT_GT(SeenBefore(seq, b, a, 10), 0.7);
+}
+
+}  // namespace
+}  // namespace detslam
