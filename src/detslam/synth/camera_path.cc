@@ -19,6 +19,22 @@ double Wave(double t, double a, double period, double phase) {
 
 }  // namespace
 
+Rigid3d EllipseCircuit(double t, double period, double a, double b, double centre_y, double bob,
+                       double look_out_deg) {
+  // Starts at (0, centre_y - b) heading +x, counter-clockwise seen from above.
+  const double th = 2.0 * kPi * t / period;
+  const Eigen::Vector3d p(a * std::sin(th), centre_y - b * std::cos(th),
+                          1.3 + bob * std::sin(3.0 * th));
+  const Eigen::Vector2d tangent = Eigen::Vector2d(a * std::cos(th), b * std::sin(th)).normalized();
+  const Eigen::Vector2d outward = Eigen::Vector2d(b * std::sin(th), -a * std::cos(th)).normalized();
+  const Eigen::Vector2d look =
+      std::cos(look_out_deg * kDeg) * tangent + std::sin(look_out_deg * kDeg) * outward;
+  const double yaw = std::atan2(-look.x(), look.y());
+  const Eigen::Matrix3d r = YawPitchRollRotation(yaw, 6 * kDeg + 2 * kDeg * std::sin(2 * th),
+                                                 1.5 * kDeg * std::sin(5 * th));
+  return Rigid3d(r, p);
+}
+
 Eigen::Matrix3d LookAtRotation(const Eigen::Vector3d& position, const Eigen::Vector3d& target) {
   const Eigen::Vector3d z = (target - position).normalized();
   const Eigen::Vector3d x = z.cross(Eigen::Vector3d::UnitZ()).normalized();
@@ -91,20 +107,15 @@ Rigid3d CameraPath::WorldFromCam(double t) const {
     const Eigen::Vector3d target(Wave(t, 0.3, 7.0, ph[2]), 1.0, 0.95);
     return Rigid3d(LookAtRotation(p, target), p);
   }
+  if (preset_ == "loop_long") {
+    // An ellipse of 9.0 x 5.2 m in the large room, once per kLoopLongPeriod (~0.35 m/s, at most
+    // 0.44 m/s), looking 55 degrees outwards (towards the furnished walls, 1.5-3 m away).
+    return EllipseCircuit(t, kLoopLongPeriod, 4.5, 2.6, 0.0, 0.05, 55.0);
+  }
   DETSLAM_CHECK_MSG(preset_ == "loop", "unhandled preset " << preset_);
   // An ellipse of 3.2 x 2.0 m in the free middle of the room, once per kLoopPeriod (~0.26 m/s),
   // looking 40 degrees outwards from the direction of travel (yaw rate ~11 deg/s).
-  const double th = 2.0 * kPi * t / kLoopPeriod;
-  const double a = 1.6, b = 1.0;
-  const Eigen::Vector3d p(a * std::sin(th), -0.6 - b * std::cos(th),
-                          1.3 + 0.04 * std::sin(3.0 * th));
-  const Eigen::Vector2d tangent = Eigen::Vector2d(a * std::cos(th), b * std::sin(th)).normalized();
-  const Eigen::Vector2d outward = Eigen::Vector2d(b * std::sin(th), -a * std::cos(th)).normalized();
-  const Eigen::Vector2d look = std::cos(40 * kDeg) * tangent + std::sin(40 * kDeg) * outward;
-  const double yaw = std::atan2(-look.x(), look.y());
-  const Eigen::Matrix3d r = YawPitchRollRotation(yaw, 6 * kDeg + 2 * kDeg * std::sin(2 * th),
-                                                 1.5 * kDeg * std::sin(5 * th));
-  return Rigid3d(r, p);
+  return EllipseCircuit(t, kLoopPeriod, 1.6, 1.0, -0.6, 0.04, 40.0);
 }
 
 }  // namespace detslam::synth

@@ -196,6 +196,11 @@ PeopleScript::PeopleScript(const std::string& preset, uint64_t seed) {
     walkers_.push_back({{0.55, 2.18}, {1, 0}, 0.06, 7.5, phase(), 0.03, 1.28, true});
     return;
   }
+  if (preset == "loop_long") {
+    // One person strolling between the loop and the far wall.
+    walkers_.push_back({{0.0, 3.2}, {1, 0}, 3.0, 26.0, phase(), 0.15, 1.72, false});
+    return;
+  }
   if (preset == "loop") {
     // One person strolling along the far side of the room.
     walkers_.push_back({{0.0, 0.3}, {1, 0}, 1.6, 18.0, phase(), 0.15, 1.72, false});

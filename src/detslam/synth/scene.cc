@@ -1,5 +1,6 @@
 #include "detslam/synth/scene.h"
 
+#include "detslam/synth/options.h"
 #include "detslam/synth/scene_builder.h"
 
 namespace detslam::synth {
@@ -60,6 +61,16 @@ Scene BuildOfficeScene(uint64_t seed) {
   b.Box(V(-3.0f, -2.5f, 1.3f), V(-2.97f, -1.8f, 2.0f), W, W, FaceIndex(0, true),
         SurfaceKind::kPoster);
   return b.Take();
+}
+
+}  // namespace detslam::synth
+
+namespace detslam::synth {
+
+Scene BuildSceneForPreset(const std::string& preset, uint64_t seed) {
+  RequireSynthPreset(preset);
+  if (preset == "loop_long") return BuildLargeOfficeScene(seed);
+  return BuildOfficeScene(seed);
 }
 
 }  // namespace detslam::synth

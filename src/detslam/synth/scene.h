@@ -8,6 +8,8 @@
 #include <array>
 #include <cstdint>
 #include <opencv2/core.hpp>
+#include <string>
+#include <utility>
 #include <vector>
 
 #include "detslam/synth/texture.h"
@@ -44,5 +46,12 @@ inline void FaceTexel(const SceneBox& box, int axis, const Eigen::Vector3f& p, f
 
 // Builds the office room; textures are seeded from `seed` (one forked generator per surface).
 Scene BuildOfficeScene(uint64_t seed);
+
+// A large office (12.6 x 8.4 x 2.8 m) for the loop_long preset: the walls lined with shelves,
+// cabinets, cardboard boxes and posters (a seeded layout), the middle free for the camera.
+Scene BuildLargeOfficeScene(uint64_t seed);
+
+// The room of a preset (the office for the TUM-like presets and `loop`).
+Scene BuildSceneForPreset(const std::string& preset, uint64_t seed);
 
 }  // namespace detslam::synth

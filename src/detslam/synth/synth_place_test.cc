@@ -1,5 +1,5 @@
-// The generator's options for place-recognition sequences: a depth-scale drift
-// (--depth-scale-bias) and a kidnapped camera (--cut).
+// The generator's sequences for place recognition: a depth-scale drift (--depth-scale-bias, the
+// loop_long preset) and a kidnapped camera (--cut).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -12,6 +12,8 @@
 
 #include "detslam/core/check.h"
 #include "detslam/io/trajectory.h"
+#include "detslam/synth/camera_path.h"
+#include "detslam/synth/scene.h"
 #include "detslam/synth/sequence.h"
 #include "detslam/synth/writer.h"
 
@@ -156,6 +158,69 @@ TEST(SynthDepthScaleTest, ScalesTheWrittenDepthOnly) {
     EXPECT_GT(checked, 3000);
   }
   EXPECT_DOUBLE_EQ(a.DepthScaleOf(30), 1.3);
+}
+
+// Where a visual odometry that trusts the biased depth believes the camera is: each step of the
+// true path scaled by that frame's depth scale. Returns how far that estimate at frame `revisit`
+// is from the estimate at frame 0 (the truth: 0, the camera is back at its start).
+double DeadReckoningGapAtRevisit(const std::string& preset, double bias, int revisit) {
+  SynthOptions o = Opts(preset);
+  o.depth_scale_bias = bias;
+  const int n = SynthFrameCount(o);
+  synth::CameraPath path(preset, 1);
+  Eigen::Vector3d est = Eigen::Vector3d::Zero();
+  for (int k = 0; k < revisit; ++k) {
+    const Eigen::Vector3d step =
+        path.WorldFromCam((k + 1) / 30.0).translation() - path.WorldFromCam(k / 30.0).translation();
+    est += SynthDepthScale(bias, k, n) * step;
+  }
+  return (est -
+          (path.WorldFromCam(revisit / 30.0).translation() - path.WorldFromCam(0.0).translation()))
+      .norm();
+}
+
+TEST(SynthDepthScaleTest, LoopLongDriftsPastLoopSearchRadiusWhereLoopCannot) {
+  // A loop detector that looks for candidates within 1.5 m of the estimated position: on `loop`
+  // (3.2 x 2.0 m circuit) even a 30 % bias moves the estimate at the revisit by < 1 m, on
+  // loop_long (9.0 x 5.2 m) 25 % move it by > 1.5 m (in scale-following odometry).
+  const int loop_revisit = static_cast<int>(synth::CameraPath::kLoopPeriod * 30);
+  const int long_revisit = static_cast<int>(synth::CameraPath::kLoopLongPeriod * 30);
+  EXPECT_LT(DeadReckoningGapAtRevisit("loop", 0.3, 899), 1.0);
+  EXPECT_GT(DeadReckoningGapAtRevisit("loop_long", 0.25, long_revisit), 1.6);
+  EXPECT_GT(DeadReckoningGapAtRevisit("loop_long", 0.3, long_revisit), 2.0);
+  EXPECT_LT(DeadReckoningGapAtRevisit("loop_long", 0.0, long_revisit), 1e-9);
+  EXPECT_LT(loop_revisit, 1000);
+}
+
+TEST(SynthLoopLongTest, ClosedCircuitInsideTheLargeRoom) {
+  synth::CameraPath path("loop_long", 3);
+  const double period = synth::CameraPath::kLoopLongPeriod;
+  const Rigid3d back = path.WorldFromCam(0).Inverse() * path.WorldFromCam(period);
+  EXPECT_LT(back.translation().norm(), 1e-9);
+  EXPECT_LT(back.RotationAngle(), 1e-9);
+  // The default length is one lap plus 3 s over the start again.
+  EXPECT_EQ(SynthPresetDefaultFrames("loop_long"), static_cast<int>(period * 30) + 90);
+  // The circuit is longer than loop's by far, and keeps 0.8 m from every piece of furniture.
+  const synth::Scene scene = synth::BuildLargeOfficeScene(3);
+  ASSERT_GT(scene.boxes.size(), 30u);
+  double length = 0, min_clearance = 1e9;
+  for (int k = 0; k < static_cast<int>(period * 30); ++k) {
+    const Eigen::Vector3d p = path.WorldFromCam(k / 30.0).translation();
+    length += (path.WorldFromCam((k + 1) / 30.0).translation() - p).norm();
+    for (size_t i = 1; i < scene.boxes.size(); ++i) {
+      const Eigen::Vector3d lo = scene.boxes[i].lo.cast<double>(),
+                            hi = scene.boxes[i].hi.cast<double>();
+      min_clearance = std::min(min_clearance, (p - p.cwiseMax(lo).cwiseMin(hi)).norm());
+    }
+  }
+  EXPECT_GT(length, 20.0);
+  EXPECT_GT(min_clearance, 0.8);
+  // Most of the view has depth (the furnished walls are in the sensor's range).
+  SyntheticSequence seq(Opts("loop_long", 3, false));
+  for (int k = 0; k < seq.size(); k += 400) {
+    const SynthFrame f = seq.Render(k);
+    EXPECT_GT(cv::countNonZero(f.depth16) / static_cast<double>(f.depth16.total()), 0.85) << k;
+  }
 }
 
 // --- kidnapped camera ------------------------------------------------------------------------
