@@ -107,6 +107,22 @@ Rigid3d CameraPath::WorldFromCam(double t) const {
     const Eigen::Vector3d target(Wave(t, 0.3, 7.0, ph[2]), 1.0, 0.95);
     return Rigid3d(LookAtRotation(p, target), p);
   }
+  if (preset_ == "lookalike") {
+    // Explores the first part of the room (x ~ -3.4), walks over to the second part (x ~ +3.4) and
+    // explores it, always facing the far wall (+y, +-12 degrees): the first part is never seen
+    // again. x follows -cos(pi s(u)) with s(u) = u - sin(2 pi u) / (2 pi), u = t / duration, so
+    // the camera lingers at both ends (peak speed ~0.48 m/s mid-way); a side-to-side sway that
+    // fades out during the passage.
+    const double u = t / kLookalikeDuration;
+    const double s = u - std::sin(2.0 * kPi * u) / (2.0 * kPi);
+    const double fade = std::cos(kPi * u) * std::cos(kPi * u);
+    const Eigen::Vector3d p(-3.4 * std::cos(kPi * s) + fade * Wave(t, 0.45, 9.0, ph[0]),
+                            -0.6 + Wave(t, 0.25, 13.0, ph[1]), 1.3 + Wave(t, 0.1, 7.0, ph[2]));
+    const Eigen::Matrix3d r = YawPitchRollRotation(Wave(t, 12 * kDeg, 10.0, ph[3]),
+                                                   6 * kDeg + Wave(t, 3 * kDeg, 8.0, ph[4]),
+                                                   Wave(t, 2 * kDeg, 6.0, ph[5]));
+    return Rigid3d(r, p);
+  }
   if (preset_ == "loop_long") {
     // An ellipse of 9.0 x 5.2 m in the large room, once per kLoopLongPeriod (~0.35 m/s, at most
     // 0.44 m/s), looking 55 degrees outwards (towards the furnished walls, 1.5-3 m away).

@@ -36,6 +36,9 @@ class CameraPath {
   static constexpr double kLoopPeriod = 32.0;
   // Period of the loop_long preset's circuit in seconds (a larger room and ellipse).
   static constexpr double kLoopLongPeriod = 64.0;
+  // Duration of the lookalike preset's script (first part, passage, second part) in seconds;
+  // beyond it the camera walks back to the first part (a true revisit).
+  static constexpr double kLookalikeDuration = 45.0;
 
  private:
   std::string preset_;

@@ -11,7 +11,7 @@ namespace detslam {
 const std::vector<std::string>& SynthPresetNames() {
   static const std::vector<std::string> kNames = {
       "static",         "walking_xyz", "walking_static", "walking_rpy", "walking_halfsphere",
-      "sitting_static", "loop",        "loop_long"};
+      "sitting_static", "loop",        "loop_long",      "lookalike"};
   return kNames;
 }
 
@@ -38,6 +38,7 @@ int SynthPresetDefaultFrames(const std::string& preset) {
   RequireSynthPreset(preset);
   if (preset == "loop") return 900;
   if (preset == "loop_long") return 2010;  // one 64 s lap, then 3 s over its start again
+  if (preset == "lookalike") return 1350;  // 45 s: first part, passage, second part
   if (preset == "walking_halfsphere") return 900;
   if (preset == "walking_static" || preset == "sitting_static") return 700;
   return 800;

@@ -201,6 +201,13 @@ PeopleScript::PeopleScript(const std::string& preset, uint64_t seed) {
     walkers_.push_back({{0.0, 3.2}, {1, 0}, 3.0, 26.0, phase(), 0.15, 1.72, false});
     return;
   }
+  if (preset == "lookalike") {
+    // One person in front of each part of the room.
+    walkers_.push_back({{-3.4, 1.3}, {1, 0.05}, 1.4, 13.0, phase(), 0.12, 1.74, false});
+    walkers_.push_back({{3.4, 1.2}, {1, -0.05}, 1.4, 15.0, phase(), 0.10, 1.68, false});
+    for (auto& w : walkers_) w.axis.normalize();
+    return;
+  }
   if (preset == "loop") {
     // One person strolling along the far side of the room.
     walkers_.push_back({{0.0, 0.3}, {1, 0}, 1.6, 18.0, phase(), 0.15, 1.72, false});

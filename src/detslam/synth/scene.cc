@@ -70,6 +70,7 @@ namespace detslam::synth {
 Scene BuildSceneForPreset(const std::string& preset, uint64_t seed) {
   RequireSynthPreset(preset);
   if (preset == "loop_long") return BuildLargeOfficeScene(seed);
+  if (preset == "lookalike") return BuildLookalikeScene(seed).scene;
   return BuildOfficeScene(seed);
 }
 

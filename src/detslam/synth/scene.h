@@ -51,6 +51,18 @@ Scene BuildOfficeScene(uint64_t seed);
 // cabinets, cardboard boxes and posters (a seeded layout), the middle free for the camera.
 Scene BuildLargeOfficeScene(uint64_t seed);
 
+// The lookalike preset's room (12.8 x 5.0 x 2.8 m): two parts along the far wall (y = 2.6) with
+// the same furnishings' textures in different layouts, and a neutral stretch between them.
+struct LookalikeScene {
+  Scene scene;
+  // Pairs (box in the first part, box in the second part) that share all face textures; their
+  // positions and sizes differ, and no two pairs keep their relative placement.
+  std::vector<std::pair<int, int>> twins;
+  static constexpr float kFirstPartMaxX = -0.9f;  // the first part lies at x < this (world)
+  static constexpr float kSecondPartMinX = 0.9f;  // the second part lies at x > this (world)
+};
+LookalikeScene BuildLookalikeScene(uint64_t seed);
+
 // The room of a preset (the office for the TUM-like presets and `loop`).
 Scene BuildSceneForPreset(const std::string& preset, uint64_t seed);
 

@@ -1,5 +1,5 @@
 // The generator's sequences for place recognition: a depth-scale drift (--depth-scale-bias, the
-// loop_long preset) and a kidnapped camera (--cut).
+// loop_long preset), a kidnapped camera (--cut) and look-alike places (the lookalike preset).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -7,10 +7,13 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <opencv2/features2d.hpp>
 #include <opencv2/imgproc.hpp>
 #include <sstream>
 
 #include "detslam/core/check.h"
+#include "detslam/core/rng.h"
+#include "detslam/geometry/rigid_ransac.h"
 #include "detslam/io/trajectory.h"
 #include "detslam/synth/camera_path.h"
 #include "detslam/synth/scene.h"
@@ -315,6 +318,138 @@ TEST(SynthCutTest, RecommendedKidnapLandsOnMappedPlaceFromAnotherViewpoint) {
   EXPECT_GT((seq.WorldFromCam(a - 1).translation() - landing.translation()).norm(), 0.5);
   // Most of what it sees after the jump was seen (mapped) before the cut.
   EXPECT_GT(SeenBefore(seq, b, a, 10), 0.7);
+}
+
+// --- look-alike places -----------------------------------------------------------------------
+
+TEST(SynthLookalikeTest, TwinsShareTexturesNotPlacement) {
+  for (uint64_t seed : {1, 2, 3}) {
+    const synth::LookalikeScene ls = synth::BuildLookalikeScene(seed);
+    ASSERT_EQ(ls.twins.size(), 28u);
+    std::vector<Eigen::Vector3f> moves;
+    for (const auto& [i, j] : ls.twins) {
+      const synth::SceneBox &first = ls.scene.boxes[i], &second = ls.scene.boxes[j];
+      EXPECT_EQ(first.texture, second.texture);
+      EXPECT_LT(first.hi.x(), synth::LookalikeScene::kFirstPartMaxX);
+      EXPECT_GT(second.lo.x(), synth::LookalikeScene::kSecondPartMinX);
+      // Different size, and each face's texture covers the face.
+      EXPECT_GT((first.hi - first.lo - (second.hi - second.lo)).cwiseAbs().maxCoeff(), 0.01f);
+      for (const synth::SceneBox* box : {&first, &second}) {
+        const cv::Mat& front = ls.scene.textures[box->texture[synth::FaceIndex(1, false)]];
+        EXPECT_GE(front.cols, (box->hi.x() - box->lo.x()) * synth::kTexelsPerMetre);
+        EXPECT_GE(front.rows, (box->hi.z() - box->lo.z()) * synth::kTexelsPerMetre);
+      }
+      // Front texture origin (FaceTexel: column from lo.x, row from hi.z) moves by this.
+      moves.push_back(Eigen::Vector3f(second.lo.x(), second.lo.y(), second.hi.z()) -
+                      Eigen::Vector3f(first.lo.x(), first.lo.y(), first.hi.z()));
+    }
+    // No rigid motion carries two twins onto each other: they all move differently.
+    for (size_t i = 0; i < moves.size(); ++i) {
+      for (size_t k = i + 1; k < moves.size(); ++k) EXPECT_GT((moves[i] - moves[k]).norm(), 0.25f);
+    }
+    // No other box uses a twin's texture.
+    std::vector<int> users(ls.scene.textures.size(), 0);
+    for (const auto& box : ls.scene.boxes) {
+      for (int t : box.texture) ++users[t];
+    }
+    for (const auto& [i, j] : ls.twins) {
+      for (int t : ls.scene.boxes[i].texture) EXPECT_EQ(users[t], 2);
+    }
+  }
+}
+
+TEST(SynthLookalikeTest, SecondPartNeverSeesTheFirst) {
+  SyntheticSequence seq(Opts("lookalike", 2, false));
+  const PinholeCamera cam = seq.camera();
+  ASSERT_EQ(seq.size(), 1350);
+  // Back-projected pixels: the first part (x < -0.9) is out of view from 65 % of the script on,
+  // the second part (x > 0.9) until 35 %.
+  for (int k = 0; k < seq.size(); k += 45) {
+    const double u = k / (30.0 * synth::CameraPath::kLookalikeDuration);
+    if (u > 0.35 && u < 0.65) continue;
+    const SynthFrame f = seq.Render(k);
+    double min_x = 1e9, max_x = -1e9;
+    for (int v = 0; v < cam.height; v += 4) {
+      for (int c = 0; c < cam.width; c += 4) {
+        const float z = f.true_depth.at<float>(v, c);
+        const Eigen::Vector3d p = f.world_from_cam * cam.Unproject(Eigen::Vector2d(c, v), z);
+        min_x = std::min(min_x, p.x());
+        max_x = std::max(max_x, p.x());
+      }
+    }
+    if (u >= 0.65) {
+      EXPECT_GT(min_x, synth::LookalikeScene::kFirstPartMaxX) << "frame " << k;
+    } else {
+      EXPECT_LT(max_x, synth::LookalikeScene::kSecondPartMinX) << "frame " << k;
+    }
+  }
+}
+
+struct PairMatch {
+  int matches = 0;        // mutual nearest ORB neighbours (Hamming <= 40) with depth in both
+  int rigid_inliers = 0;  // largest set one rigid motion explains (3 cm)
+};
+
+// Matches ORB features of two frames and finds the largest rigidly consistent subset of the
+// matches' 3-D points (each in its own camera frame).
+PairMatch MatchFrames(const SynthFrame& a, const SynthFrame& b, const PinholeCamera& cam) {
+  cv::Ptr<cv::ORB> orb = cv::ORB::create(1000);
+  std::vector<cv::KeyPoint> ka, kb;
+  cv::Mat da, db, ga, gb;
+  cv::cvtColor(a.bgr, ga, cv::COLOR_BGR2GRAY);
+  cv::cvtColor(b.bgr, gb, cv::COLOR_BGR2GRAY);
+  orb->detectAndCompute(ga, cv::noArray(), ka, da);
+  orb->detectAndCompute(gb, cv::noArray(), kb, db);
+  cv::BFMatcher matcher(cv::NORM_HAMMING, /*crossCheck=*/true);
+  std::vector<cv::DMatch> matches;
+  matcher.match(da, db, matches);
+  std::vector<Eigen::Vector3d> pa, pb;
+  for (const cv::DMatch& m : matches) {
+    if (m.distance > 40) continue;
+    const cv::Point2f ua = ka[m.queryIdx].pt, ub = kb[m.trainIdx].pt;
+    const float za = a.true_depth.at<float>(cvRound(ua.y), cvRound(ua.x));
+    const float zb = b.true_depth.at<float>(cvRound(ub.y), cvRound(ub.x));
+    if (za <= 0 || zb <= 0) continue;
+    pa.push_back(cam.Unproject(Eigen::Vector2d(ua.x, ua.y), za));
+    pb.push_back(cam.Unproject(Eigen::Vector2d(ub.x, ub.y), zb));
+  }
+  PairMatch out;
+  out.matches = static_cast<int>(pa.size());
+  RansacOptions ransac;
+  ransac.max_iterations = 2000;
+  ransac.min_inliers = 3;
+  Rng rng(5);
+  out.rigid_inliers = EstimateRigidRansac(pa, pb, 0.03, ransac, rng).num_inliers;
+  return out;
+}
+
+TEST(SynthLookalikeTest, PartsLookAlikeButDoNotAlignRigidly) {
+  SyntheticSequence seq(Opts("lookalike", 1, true));
+  SyntheticSequence office(Opts("static", 1, true));
+  const PinholeCamera cam = seq.camera();
+  // The same moment of the sway in the first and the second part, and a true revisit: the
+  // first part 1 s later.
+  int alike_matches = 0, alike_inliers = 0, revisit_inliers = 1 << 30, other_matches = 0;
+  for (int k : {0, 120, 240}) {
+    const SynthFrame first = seq.Render(k), second = seq.Render(seq.size() - 1 - k);
+    const PairMatch alike = MatchFrames(first, second, cam);
+    const PairMatch revisit = MatchFrames(first, seq.Render(k + 30), cam);
+    const PairMatch other = MatchFrames(first, office.Render(k), cam);
+    alike_matches += alike.matches;
+    alike_inliers = std::max(alike_inliers, alike.rigid_inliers);
+    revisit_inliers = std::min(revisit_inliers, revisit.rigid_inliers);
+    other_matches += other.matches;
+    std::printf("frame %d: alike %d matches, %d rigid; revisit %d / %d; other room %d / %d\n", k,
+                alike.matches, alike.rigid_inliers, revisit.matches, revisit.rigid_inliers,
+                other.matches, other.rigid_inliers);
+  }
+  // Many more matches between the parts than with another room (same generator, other textures)
+  // ...
+  EXPECT_GT(alike_matches, 120);
+  EXPECT_GT(alike_matches, 10 * std::max(1, other_matches));
+  // ... but one rigid motion explains few of them (one item's worth), a true revisit most.
+  EXPECT_LE(alike_inliers, 25);
+  EXPECT_GT(revisit_inliers, 5 * alike_inliers);
 }
 
 }  // namespace

@@ -49,7 +49,7 @@ TEST(SynthOptionsTest, UnknownPresetIsAnInputErrorListingValidOnes) {
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("walking_halfsphere"), std::string::npos) << e.what();
   }
-  EXPECT_EQ(SynthPresetNames().size(), 8u);
+  EXPECT_EQ(SynthPresetNames().size(), 9u);
 }
 
 TEST(SynthSequenceTest, DepthBackProjectsOntoSceneSurfaces) {

@@ -149,6 +149,9 @@ cv::Mat MakeSurfaceTexture(SurfaceKind kind, int width_px, int height_px, Rng& r
     case SurfaceKind::kScreen:
       base = Jitter(cv::Scalar(35, 30, 30), 10, rng);
       break;
+    case SurfaceKind::kPlainWall:
+      base = Jitter(cv::Scalar(175, 192, 200), 15, rng);
+      break;
   }
   img = cv::Mat(h, w, CV_8UC3, base);
   const double m = kTexelsPerMetre;
@@ -219,6 +222,10 @@ cv::Mat MakeSurfaceTexture(SurfaceKind kind, int width_px, int height_px, Rng& r
       break;
     case SurfaceKind::kScreen:
       Clutter(img, base, 500, 60, rng);
+      break;
+    case SurfaceKind::kPlainWall:
+      AddLowFrequency(img, 10, rng);
+      Clutter(img, base, 8, 25, rng);
       break;
   }
   Grain(img, 3.0, rng);
