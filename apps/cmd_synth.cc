@@ -16,6 +16,7 @@ void AddSynthCommand(CLI::App& app) {
   auto out_dir = std::make_shared<std::string>();
   auto stats_json = std::make_shared<std::string>();
   auto no_people = std::make_shared<bool>(false);
+  auto cut = std::make_shared<std::string>();
   std::string presets;
   for (const auto& p : SynthPresetNames()) presets += (presets.empty() ? "" : ", ") + p;
   cmd->add_option("--preset", opts->preset, "Camera/people script: " + presets)
@@ -27,21 +28,34 @@ void AddSynthCommand(CLI::App& app) {
                   "Folder of RGBA person cut-outs (*.png, alpha = silhouette) to texture people");
   cmd->add_flag("--no-people", *no_people, "Static twin: same camera path, no moving people");
   cmd->add_flag("--blur", opts->motion_blur, "Motion blur from the camera velocity");
+  cmd->add_option("--depth-scale-bias", opts->depth_scale_bias,
+                  "Depth miscalibration F: written depth x 1 + F sin^2(pi k / (frames - 1)) (rises "
+                  "to 1 + F mid-sequence, back to 1 at the end; ground truth stays true); 0 = off")
+      ->capture_default_str();
+  cmd->add_option("--cut", *cut,
+                  "A:B drops frames A..B-1 from the written sequence (the camera keeps moving: "
+                  "frame A-1 is followed by frame B, a kidnapped camera)");
   cmd->add_option("--out", *out_dir, "Output folder")->required();
   cmd->add_option("--stats-json", *stats_json,
                   "Write timing and content statistics (fps, FAST corners, coverage) as JSON");
-  cmd->callback([opts, out_dir, stats_json, no_people] {
+  cmd->callback([opts, out_dir, stats_json, no_people, cut] {
     opts->people = !*no_people;
+    if (!cut->empty()) ParseSynthCut(*cut, opts.get());
     RequireSynthPreset(opts->preset);
     std::string error;
     if (!opts->Check(&error)) throw InputError("detslam synth: " + error);
     const SynthStats s = WriteSequence(*opts, *out_dir);
     if (!stats_json->empty()) {
+      const nlohmann::json cut_frames =
+          opts->HasCut() ? nlohmann::json::array({opts->cut_begin, opts->cut_end})
+                         : nlohmann::json();
       nlohmann::json j = {{"preset", opts->preset},
                           {"seed", opts->seed},
                           {"people", opts->people},
                           {"people_dir", opts->people_dir},
                           {"motion_blur", opts->motion_blur},
+                          {"depth_scale_bias", opts->depth_scale_bias},
+                          {"cut", cut_frames},
                           {"frames", s.frames},
                           {"render_seconds", s.render_seconds},
                           {"total_seconds", s.total_seconds},

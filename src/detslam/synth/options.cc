@@ -1,6 +1,7 @@
 #include "detslam/synth/options.h"
 
 #include <algorithm>
+#include <cmath>
 #include <sstream>
 
 #include "detslam/core/check.h"
@@ -9,8 +10,8 @@ namespace detslam {
 
 const std::vector<std::string>& SynthPresetNames() {
   static const std::vector<std::string> kNames = {
-      "static", "walking_xyz", "walking_static", "walking_rpy", "walking_halfsphere",
-      "sitting_static", "loop"};
+      "static",         "walking_xyz", "walking_static", "walking_rpy", "walking_halfsphere",
+      "sitting_static", "loop",        "loop_long",      "lookalike"};
   return kNames;
 }
 
@@ -36,6 +37,8 @@ void RequireSynthPreset(const std::string& preset) {
 int SynthPresetDefaultFrames(const std::string& preset) {
   RequireSynthPreset(preset);
   if (preset == "loop") return 900;
+  if (preset == "loop_long") return 2010;  // one 64 s lap, then 3 s over its start again
+  if (preset == "lookalike") return 1350;  // 45 s: first part, passage, second part
   if (preset == "walking_halfsphere") return 900;
   if (preset == "walking_static" || preset == "sitting_static") return 700;
   return 800;
@@ -51,8 +54,50 @@ bool SynthOptions::Check(std::string* error) const {
     os << "unknown preset '" << preset << "' (valid: " << ValidPresetList() << "); ";
   }
   if (frames == 0 || frames > 100000) os << "frames must be in 1..100000 or negative (default); ";
+  if (!(std::abs(depth_scale_bias) <= kMaxDepthScaleBias)) {
+    os << "--depth-scale-bias must be a number in [" << -kMaxDepthScaleBias << ", "
+       << kMaxDepthScaleBias << "] (got " << depth_scale_bias << "); ";
+  }
+  if (cut_begin != 0 || cut_end != 0) {
+    // The frame count is only known for a valid preset.
+    const int n =
+        IsSynthPreset(preset) && frames != 0 && frames <= 100000 ? SynthFrameCount(*this) : -1;
+    if (cut_begin < 1 || cut_end <= cut_begin || (n > 0 && cut_end >= n)) {
+      os << "--cut " << cut_begin << ":" << cut_end << " must satisfy 1 <= A < B <= frames - 1";
+      if (n > 0) os << " = " << n - 1;
+      os << " (at least one frame before and after the cut); ";
+    }
+  }
   if (error != nullptr) *error = os.str();
   return os.str().empty();
+}
+
+void ParseSynthCut(const std::string& text, SynthOptions* options) {
+  const auto bad = [&](const std::string& why) {
+    return InputError("--cut '" + text + "': " + why + " (expected A:B, frame indices, A < B)");
+  };
+  const size_t colon = text.find(':');
+  if (colon == std::string::npos || text.find(':', colon + 1) != std::string::npos) {
+    throw bad("needs exactly one ':'");
+  }
+  const auto parse = [&](const std::string& part) {
+    if (part.empty() || part.size() > 9 ||
+        !std::all_of(part.begin(), part.end(), [](char c) { return c >= '0' && c <= '9'; })) {
+      throw bad("'" + part + "' is not a frame index");
+    }
+    return std::stoi(part);
+  };
+  const int a = parse(text.substr(0, colon)), b = parse(text.substr(colon + 1));
+  if (a >= b) throw bad("A must be less than B");
+  options->cut_begin = a;
+  options->cut_end = b;
+}
+
+double SynthDepthScale(double bias, int k, int frames) {
+  if (bias == 0.0 || frames < 2) return 1.0;
+  constexpr double kPi = 3.14159265358979323846;
+  const double s = std::sin(kPi * static_cast<double>(k) / (frames - 1));
+  return 1.0 + bias * s * s;
 }
 
 }  // namespace detslam

@@ -15,10 +15,29 @@ struct SynthOptions {
   bool people = true;                  // false: the static twin (same camera path, no people)
   bool motion_blur = false;            // blur colour images along the camera's image motion
   bool sensor_noise = true;            // false: ideal depth and colour (tests of the geometry)
+  double depth_scale_bias = 0.0;       // F: written depth x (1 + F sin^2(pi k / (N - 1))); 0 = off
+  int cut_begin = 0;                   // frames cut_begin..cut_end-1 are not written (`--cut A:B`)
+  int cut_end = 0;                     // cut_end <= cut_begin (default 0, 0): no cut
 
-  // True if the options are valid; otherwise fills `error` (may be null) with the reasons.
+  // True if frames [cut_begin, cut_end) are to be dropped from the written sequence.
+  bool HasCut() const { return cut_end > cut_begin; }
+
+  // True if the options are valid; otherwise fills `error` (may be null) with the reasons, each
+  // naming its command-line option.
   bool Check(std::string* error) const;
 };
+
+// Largest |depth_scale_bias| accepted (a sensor whose depth is off by more is not plausible).
+constexpr double kMaxDepthScaleBias = 0.5;
+
+// Parses the `--cut A:B` value (two non-negative integers, A < B) into options->cut_begin and
+// options->cut_end; throws InputError naming --cut otherwise. Whether the cut lies inside the
+// sequence is checked by SynthOptions::Check (it needs the frame count).
+void ParseSynthCut(const std::string& text, SynthOptions* options);
+
+// Scale of the written depth at frame k of a sequence of `frames` frames with bias F: it rises
+// from 1 at the first frame to 1 + F at the middle and falls back to 1 at the last (sin^2 ramp).
+double SynthDepthScale(double bias, int k, int frames);
 
 // The valid preset names, in a fixed order.
 const std::vector<std::string>& SynthPresetNames();

@@ -97,7 +97,8 @@ std::vector<PersonLook> LoadPhotoPeople(const std::string& dir) {
     const cv::Mat rgba = cv::imread(file, cv::IMREAD_UNCHANGED);
     if (rgba.empty()) throw InputError(file, 0, "cannot read PNG");
     if (rgba.channels() != 4) {
-      throw InputError(file, 0, "person cut-out has no alpha channel (need RGBA, alpha = silhouette)");
+      throw InputError(file, 0,
+                       "person cut-out has no alpha channel (need RGBA, alpha = silhouette)");
     }
     cv::Mat rgba8 = rgba;
     if (rgba.depth() == CV_16U) rgba.convertTo(rgba8, CV_8U, 1.0 / 257.0);
@@ -120,7 +121,8 @@ PersonLook MakeProceduralPerson(uint64_t seed, int phases) {
   const int w = 200, h = 480;  // aspect of a person with arms at the sides (~0.7 m x 1.7 m)
   const cv::Mat shirt = ClothTexture(cv::Size(w, h), rng);
   const cv::Mat pants = ClothTexture(cv::Size(w, h), rng) * 0.55;
-  const cv::Scalar skin(rng.UniformInt(60, 150), rng.UniformInt(100, 170), rng.UniformInt(150, 220));
+  const cv::Scalar skin(rng.UniformInt(60, 150), rng.UniformInt(100, 170),
+                        rng.UniformInt(150, 220));
   const cv::Scalar hair = RandomCloth(rng) * 0.35;
   const cv::Scalar shoes = RandomCloth(rng) * 0.3;
   const double shoulder = rng.Uniform(0.2, 0.24) * w;
@@ -139,8 +141,9 @@ PersonLook MakeProceduralPerson(uint64_t seed, int phases) {
       cv::ellipse(m_shoes, foot + cv::Point2d(3, 0), cv::Size(static_cast<int>(0.08 * w), 7), 0, 0,
                   360, cv::Scalar(255), cv::FILLED, cv::LINE_AA);
     }
-    cv::rectangle(m_pants, cv::Rect(static_cast<int>(cx - 0.16 * w), static_cast<int>(0.5 * h),
-                                    static_cast<int>(0.32 * w), static_cast<int>(0.08 * h)),
+    cv::rectangle(m_pants,
+                  cv::Rect(static_cast<int>(cx - 0.16 * w), static_cast<int>(0.5 * h),
+                           static_cast<int>(0.32 * w), static_cast<int>(0.08 * h)),
                   cv::Scalar(255), cv::FILLED);
     // Torso.
     std::vector<cv::Point> torso = {
@@ -155,11 +158,13 @@ PersonLook MakeProceduralPerson(uint64_t seed, int phases) {
       const double a = -side * swing * 0.8 + side * 0.06;
       Limb(m_shirt, sh, a, 0.3 * h, static_cast<int>(0.085 * w));
       const cv::Point2d hand = sh + 0.33 * h * cv::Point2d(std::sin(a), std::cos(a));
-      cv::circle(m_skin, hand, static_cast<int>(0.045 * w), cv::Scalar(255), cv::FILLED, cv::LINE_AA);
+      cv::circle(m_skin, hand, static_cast<int>(0.045 * w), cv::Scalar(255), cv::FILLED,
+                 cv::LINE_AA);
     }
     // Neck, head, hair.
-    cv::rectangle(m_skin, cv::Rect(static_cast<int>(cx - 0.05 * w), static_cast<int>(0.12 * h),
-                                   static_cast<int>(0.1 * w), static_cast<int>(0.06 * h)),
+    cv::rectangle(m_skin,
+                  cv::Rect(static_cast<int>(cx - 0.05 * w), static_cast<int>(0.12 * h),
+                           static_cast<int>(0.1 * w), static_cast<int>(0.06 * h)),
                   cv::Scalar(255), cv::FILLED);
     cv::ellipse(m_skin, cv::Point2d(cx, 0.075 * h), cv::Size(static_cast<int>(0.11 * w), 0.065 * h),
                 0, 0, 360, cv::Scalar(255), cv::FILLED, cv::LINE_AA);
@@ -189,6 +194,18 @@ PeopleScript::PeopleScript(const std::string& preset, uint64_t seed) {
     // Two people sitting behind the far edge of the table, facing the camera.
     walkers_.push_back({{-0.5, 2.15}, {1, 0}, 0.05, 6.0, phase(), 0.03, 1.32, true});
     walkers_.push_back({{0.55, 2.18}, {1, 0}, 0.06, 7.5, phase(), 0.03, 1.28, true});
+    return;
+  }
+  if (preset == "loop_long") {
+    // One person strolling between the loop and the far wall.
+    walkers_.push_back({{0.0, 3.2}, {1, 0}, 3.0, 26.0, phase(), 0.15, 1.72, false});
+    return;
+  }
+  if (preset == "lookalike") {
+    // One person in front of each part of the room.
+    walkers_.push_back({{-3.4, 1.3}, {1, 0.05}, 1.4, 13.0, phase(), 0.12, 1.74, false});
+    walkers_.push_back({{3.4, 1.2}, {1, -0.05}, 1.4, 15.0, phase(), 0.10, 1.68, false});
+    for (auto& w : walkers_) w.axis.normalize();
     return;
   }
   if (preset == "loop") {

@@ -55,14 +55,14 @@ class PeopleScript {
 
  private:
   struct Walker {
-    Eigen::Vector2d centre;   // middle of the walk (world x, y)
-    Eigen::Vector2d axis;     // unit direction of the walk
-    double amplitude;         // half length of the walk (metres)
-    double period;            // seconds for one back-and-forth
-    double phase;             // radians
-    double sway;              // sideways sway amplitude (metres)
-    double height;            // metres
-    bool sitting;             // small motions only, no gait
+    Eigen::Vector2d centre;  // middle of the walk (world x, y)
+    Eigen::Vector2d axis;    // unit direction of the walk
+    double amplitude;        // half length of the walk (metres)
+    double period;           // seconds for one back-and-forth
+    double phase;            // radians
+    double sway;             // sideways sway amplitude (metres)
+    double height;           // metres
+    bool sitting;            // small motions only, no gait
   };
   std::vector<Walker> walkers_;
 };

@@ -1,80 +1,9 @@
 #include "detslam/synth/scene.h"
 
-#include <algorithm>
-#include <cmath>
-
-#include "detslam/core/rng.h"
+#include "detslam/synth/options.h"
+#include "detslam/synth/scene_builder.h"
 
 namespace detslam::synth {
-namespace {
-
-class SceneBuilder {
- public:
-  explicit SceneBuilder(uint64_t seed) : rng_(seed) {}
-
-  // Adds a box whose faces use `sides` texture, the top (+z) face `top`; `special_face` (if >= 0)
-  // uses `special`.
-  void Box(Eigen::Vector3f lo, Eigen::Vector3f hi, SurfaceKind sides, SurfaceKind top,
-           int special_face = -1, SurfaceKind special = SurfaceKind::kPoster, bool interior = false) {
-    SceneBox b;
-    b.lo = lo;
-    b.hi = hi;
-    b.interior = interior;
-    for (int axis = 0; axis < 3; ++axis) {
-      const int ua = axis == 0 ? 1 : 0;
-      const int va = axis == 2 ? 1 : 2;
-      const int w = static_cast<int>(std::ceil((hi[ua] - lo[ua]) * kTexelsPerMetre)) + 2;
-      const int h = static_cast<int>(std::ceil((hi[va] - lo[va]) * kTexelsPerMetre)) + 2;
-      for (int side = 0; side < 2; ++side) {
-        const int face = FaceIndex(axis, side == 1);
-        SurfaceKind kind = (axis == 2 && side == 1) ? top : sides;
-        if (face == special_face) kind = special;
-        Rng surface_rng = rng_.Fork(static_cast<uint64_t>(scene_.textures.size()) + 1);
-        b.texture[face] = static_cast<int>(scene_.textures.size());
-        scene_.textures.push_back(MakeSurfaceTexture(kind, w, h, surface_rng));
-      }
-    }
-    scene_.boxes.push_back(b);
-  }
-
-  // A desk: top slab, four legs, optional front panel.
-  void Desk(float x0, float x1, float y0, float y1, bool panel) {
-    const float top = 0.72f, th = 0.035f, leg = 0.05f;
-    Box({x0, y0, top}, {x1, y1, top + th}, SurfaceKind::kWood, SurfaceKind::kWood);
-    for (float x : {x0 + 0.03f, x1 - 0.03f - leg}) {
-      for (float y : {y0 + 0.03f, y1 - 0.03f - leg}) {
-        Box({x, y, 0.f}, {x + leg, y + leg, top}, SurfaceKind::kMetal, SurfaceKind::kMetal);
-      }
-    }
-    if (panel) {
-      Box({x0 + 0.08f, y0 + 0.04f, 0.28f}, {x1 - 0.08f, y0 + 0.07f, top}, SurfaceKind::kMetal,
-          SurfaceKind::kMetal);
-    }
-  }
-
-  // A monitor standing on a desk at height z, screen facing -y (towards the default camera) if
-  // `faces_minus_y`, else facing -x.
-  void Monitor(float cx, float cy, float z, bool faces_minus_y) {
-    const float w = 0.27f, d = 0.025f;
-    if (faces_minus_y) {
-      Box({cx - w, cy, z + 0.1f}, {cx + w, cy + d, z + 0.45f}, SurfaceKind::kMetal,
-          SurfaceKind::kMetal, FaceIndex(1, false), SurfaceKind::kScreen);
-      Box({cx - 0.03f, cy + d, z}, {cx + 0.03f, cy + d + 0.04f, z + 0.12f}, SurfaceKind::kMetal,
-          SurfaceKind::kMetal);
-    } else {
-      Box({cx, cy - w, z + 0.1f}, {cx + d, cy + w, z + 0.45f}, SurfaceKind::kMetal,
-          SurfaceKind::kMetal, FaceIndex(0, true), SurfaceKind::kScreen);
-    }
-  }
-
-  Scene Take() { return std::move(scene_); }
-
- private:
-  Rng rng_;
-  Scene scene_;
-};
-
-}  // namespace
 
 Scene BuildOfficeScene(uint64_t seed) {
   SceneBuilder b(seed ^ 0x5CE4EULL);
@@ -89,13 +18,16 @@ Scene BuildOfficeScene(uint64_t seed) {
   b.Desk(-1.3f, 1.3f, 0.6f, 1.9f, true);
   b.Monitor(-1.0f, 1.2f, 0.755f, true);
   b.Monitor(1.0f, 1.2f, 0.755f, true);
-  b.Box(V(-0.35f, 0.75f, 0.755f), V(0.15f, 0.92f, 0.78f), SurfaceKind::kMetal, SurfaceKind::kScreen);
+  b.Box(V(-0.35f, 0.75f, 0.755f), V(0.15f, 0.92f, 0.78f), SurfaceKind::kMetal,
+        SurfaceKind::kScreen);
   b.Box(V(0.3f, 0.7f, 0.755f), V(0.62f, 1.0f, 0.765f), SurfaceKind::kPoster, SurfaceKind::kPoster);
-  b.Box(V(-0.7f, 0.8f, 0.755f), V(-0.6f, 0.9f, 0.87f), SurfaceKind::kCardboard, SurfaceKind::kMetal);
+  b.Box(V(-0.7f, 0.8f, 0.755f), V(-0.6f, 0.9f, 0.87f), SurfaceKind::kCardboard,
+        SurfaceKind::kMetal);
   // Side desk along the left wall with a monitor and boxes below.
   b.Desk(-3.0f, -2.25f, -1.6f, 0.9f, false);
   b.Monitor(-2.85f, -0.4f, 0.755f, false);
-  b.Box(V(-2.9f, 0.1f, 0.0f), V(-2.4f, 0.6f, 0.42f), SurfaceKind::kCardboard, SurfaceKind::kCardboard);
+  b.Box(V(-2.9f, 0.1f, 0.0f), V(-2.4f, 0.6f, 0.42f), SurfaceKind::kCardboard,
+        SurfaceKind::kCardboard);
   b.Box(V(-2.9f, -1.4f, 0.755f), V(-2.55f, -1.0f, 0.95f), SurfaceKind::kCardboard,
         SurfaceKind::kCardboard);
   // Far wall: two shelves full of books and posters between them.
@@ -103,25 +35,43 @@ Scene BuildOfficeScene(uint64_t seed) {
         FaceIndex(1, false), SurfaceKind::kBooks);
   b.Box(V(1.45f, 2.25f, 0.0f), V(2.8f, 2.6f, 1.75f), SurfaceKind::kWood, SurfaceKind::kCardboard,
         FaceIndex(1, false), SurfaceKind::kBooks);
-  b.Box(V(-1.0f, 2.57f, 1.3f), V(0.15f, 2.6f, 2.15f), W, W, FaceIndex(1, false), SurfaceKind::kPoster);
-  b.Box(V(0.35f, 2.57f, 1.05f), V(1.15f, 2.6f, 1.95f), W, W, FaceIndex(1, false), SurfaceKind::kPoster);
+  b.Box(V(-1.0f, 2.57f, 1.3f), V(0.15f, 2.6f, 2.15f), W, W, FaceIndex(1, false),
+        SurfaceKind::kPoster);
+  b.Box(V(0.35f, 2.57f, 1.05f), V(1.15f, 2.6f, 1.95f), W, W, FaceIndex(1, false),
+        SurfaceKind::kPoster);
   // Right wall: cabinet, whiteboard, stacked boxes, a door.
   b.Box(V(2.5f, -1.0f, 0.0f), V(3.0f, 0.2f, 1.1f), SurfaceKind::kMetal, SurfaceKind::kWood);
   b.Box(V(2.97f, 0.4f, 0.9f), V(3.0f, 2.0f, 2.0f), W, W, FaceIndex(0, false), SurfaceKind::kPoster);
   b.Box(V(2.2f, 1.0f, 0.0f), V(2.8f, 1.6f, 0.5f), SurfaceKind::kCardboard, SurfaceKind::kCardboard);
-  b.Box(V(2.3f, 1.1f, 0.5f), V(2.7f, 1.5f, 0.82f), SurfaceKind::kCardboard, SurfaceKind::kCardboard);
+  b.Box(V(2.3f, 1.1f, 0.5f), V(2.7f, 1.5f, 0.82f), SurfaceKind::kCardboard,
+        SurfaceKind::kCardboard);
   b.Box(V(2.96f, -2.3f, 0.0f), V(3.0f, -1.4f, 2.1f), SurfaceKind::kWood, SurfaceKind::kWood,
         FaceIndex(0, false), SurfaceKind::kWood);
   // Back wall (behind the default camera): shelf, posters, boxes.
   b.Box(V(-1.1f, -2.8f, 0.0f), V(0.9f, -2.42f, 1.9f), SurfaceKind::kWood, SurfaceKind::kWood,
         FaceIndex(1, true), SurfaceKind::kBooks);
-  b.Box(V(1.3f, -2.8f, 1.0f), V(2.3f, -2.77f, 1.9f), W, W, FaceIndex(1, true), SurfaceKind::kPoster);
-  b.Box(V(-2.6f, -2.8f, 0.0f), V(-1.9f, -2.2f, 0.6f), SurfaceKind::kCardboard, SurfaceKind::kCardboard);
+  b.Box(V(1.3f, -2.8f, 1.0f), V(2.3f, -2.77f, 1.9f), W, W, FaceIndex(1, true),
+        SurfaceKind::kPoster);
+  b.Box(V(-2.6f, -2.8f, 0.0f), V(-1.9f, -2.2f, 0.6f), SurfaceKind::kCardboard,
+        SurfaceKind::kCardboard);
   b.Box(V(1.6f, -2.6f, 0.0f), V(2.2f, -2.1f, 0.75f), SurfaceKind::kMetal, SurfaceKind::kWood);
   // Left wall posters.
-  b.Box(V(-3.0f, 1.2f, 1.2f), V(-2.97f, 2.1f, 2.05f), W, W, FaceIndex(0, true), SurfaceKind::kPoster);
-  b.Box(V(-3.0f, -2.5f, 1.3f), V(-2.97f, -1.8f, 2.0f), W, W, FaceIndex(0, true), SurfaceKind::kPoster);
+  b.Box(V(-3.0f, 1.2f, 1.2f), V(-2.97f, 2.1f, 2.05f), W, W, FaceIndex(0, true),
+        SurfaceKind::kPoster);
+  b.Box(V(-3.0f, -2.5f, 1.3f), V(-2.97f, -1.8f, 2.0f), W, W, FaceIndex(0, true),
+        SurfaceKind::kPoster);
   return b.Take();
+}
+
+}  // namespace detslam::synth
+
+namespace detslam::synth {
+
+Scene BuildSceneForPreset(const std::string& preset, uint64_t seed) {
+  RequireSynthPreset(preset);
+  if (preset == "loop_long") return BuildLargeOfficeScene(seed);
+  if (preset == "lookalike") return BuildLookalikeScene(seed).scene;
+  return BuildOfficeScene(seed);
 }
 
 }  // namespace detslam::synth

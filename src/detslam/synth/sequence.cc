@@ -45,7 +45,7 @@ SyntheticSequence::SyntheticSequence(const SynthOptions& options)
     : options_(Validated(options)),
       frames_(SynthFrameCount(options)),
       camera_(SynthCamera()),
-      scene_(synth::BuildOfficeScene(options.seed)),
+      scene_(synth::BuildSceneForPreset(options.preset, options.seed)),
       path_(options.preset, options.seed),
       people_(options.preset, options.seed) {
   if (!options_.people_dir.empty()) {
@@ -75,6 +75,10 @@ Rigid3d SyntheticSequence::WorldFromCam(int k) const {
   return path_.WorldFromCam(static_cast<double>(k) / camera_.fps);
 }
 
+double SyntheticSequence::DepthScaleOf(int k) const {
+  return SynthDepthScale(options_.depth_scale_bias, k, frames_);
+}
+
 SynthFrame SyntheticSequence::Render(int k) const {
   DETSLAM_CHECK_MSG(k >= 0 && k < frames_, "frame " << k << " out of range 0.." << frames_ - 1);
   const double t = static_cast<double>(k) / camera_.fps;
@@ -93,7 +97,8 @@ SynthFrame SyntheticSequence::Render(int k) const {
     // Image motion during a 1/60 s exposure of the point at the median depth on the optical axis
     // (a global linear blur along the camera's image-plane velocity).
     const double exposure = 1.0 / 60.0;
-    const Rigid3d a = path_.WorldFromCam(t - 0.5 * exposure), b = path_.WorldFromCam(t + 0.5 * exposure);
+    const Rigid3d a = path_.WorldFromCam(t - 0.5 * exposure),
+                  b = path_.WorldFromCam(t + 0.5 * exposure);
     std::vector<float> z(ideal.depth.begin<float>(), ideal.depth.end<float>());
     std::nth_element(z.begin(), z.begin() + z.size() / 2, z.end());
     const double zm = std::max(0.5f, z[z.size() / 2]);
@@ -104,8 +109,11 @@ SynthFrame SyntheticSequence::Render(int k) const {
                                                static_cast<float>(uv_b.y() - uv_a.y())));
   }
   if (options_.sensor_noise) synth::AddColourNoise(&f.bgr, sensor_, options_.seed, k);
-  f.depth16 = synth::MakeDepth16(ideal.depth, camera_, sensor_, options_.seed, k,
-                                 options_.sensor_noise);
+  // A miscalibrated sensor (--depth-scale-bias): every depth it measures is `scale` x the truth.
+  // true_depth and the pose stay true.
+  const double scale = DepthScaleOf(k);
+  const cv::Mat sensed = scale == 1.0 ? ideal.depth : cv::Mat(ideal.depth * scale);
+  f.depth16 = synth::MakeDepth16(sensed, camera_, sensor_, options_.seed, k, options_.sensor_noise);
   // Instances: bounding boxes of the visible mask pixels.
   std::map<int, SynthInstance> found;
   for (int v = 0; v < f.instance_mask.rows; ++v) {

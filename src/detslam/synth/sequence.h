@@ -3,10 +3,9 @@
 // effects, ground-truth poses and per-frame instance masks of the moving people.
 #pragma once
 
+#include <opencv2/core.hpp>
 #include <string>
 #include <vector>
-
-#include <opencv2/core.hpp>
 
 #include "detslam/core/camera.h"
 #include "detslam/core/rigid3d.h"
@@ -25,22 +24,22 @@ PinholeCamera SynthCamera();
 
 // One moving object visible in a frame.
 struct SynthInstance {
-  int id = 0;                      // instance id in the mask (1..N)
-  std::string label = "person";    // COCO class name
-  float score = 1.0f;              // ground truth: always 1
-  cv::Rect box;                    // bounding box of the visible mask pixels
-  int pixels = 0;                  // number of visible mask pixels
+  int id = 0;                    // instance id in the mask (1..N)
+  std::string label = "person";  // COCO class name
+  float score = 1.0f;            // ground truth: always 1
+  cv::Rect box;                  // bounding box of the visible mask pixels
+  int pixels = 0;                // number of visible mask pixels
 };
 
 struct SynthFrame {
-  int index = 0;                   // frame number k
-  Timestamp stamp;                 // colour image time: epoch + k / 30 s (whole microseconds)
-  Timestamp depth_stamp;           // depth image time: stamp + a few milliseconds
-  Rigid3d world_from_cam;          // ground-truth camera pose at `stamp`
-  cv::Mat bgr;                     // CV_8UC3 colour (BGR order in memory)
-  cv::Mat depth16;                 // CV_16U depth, metres * 5000, 0 = missing
-  cv::Mat instance_mask;           // CV_16U, 0 static, k = person k
-  cv::Mat true_depth;              // CV_32F noise-free depth (metres), for tests and statistics
+  int index = 0;           // frame number k
+  Timestamp stamp;         // colour image time: epoch + k / 30 s (whole microseconds)
+  Timestamp depth_stamp;   // depth image time: stamp + a few milliseconds
+  Rigid3d world_from_cam;  // ground-truth camera pose at `stamp`
+  cv::Mat bgr;             // CV_8UC3 colour (BGR order in memory)
+  cv::Mat depth16;         // CV_16U depth, metres * 5000, 0 = missing
+  cv::Mat instance_mask;   // CV_16U, 0 static, k = person k
+  cv::Mat true_depth;      // CV_32F noise-free depth (metres), for tests and statistics
   std::vector<SynthInstance> instances;  // visible people, by id
   // Fraction of pixels covered by moving objects.
   double Coverage() const;
@@ -59,6 +58,8 @@ class SyntheticSequence {
   Timestamp StampOf(int k) const;
   Timestamp DepthStampOf(int k) const;
   Rigid3d WorldFromCam(int k) const;
+  // Factor the written depth of frame k is multiplied by (options.depth_scale_bias; 1 if off).
+  double DepthScaleOf(int k) const;
 
   // Renders frame k (0 <= k < size()); thread-safe, deterministic.
   SynthFrame Render(int k) const;

@@ -49,7 +49,7 @@ TEST(SynthOptionsTest, UnknownPresetIsAnInputErrorListingValidOnes) {
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("walking_halfsphere"), std::string::npos) << e.what();
   }
-  EXPECT_EQ(SynthPresetNames().size(), 7u);
+  EXPECT_EQ(SynthPresetNames().size(), 9u);
 }
 
 TEST(SynthSequenceTest, DepthBackProjectsOntoSceneSurfaces) {
@@ -147,8 +147,8 @@ TEST(SynthSequenceTest, EveryPresetHasManyFastCorners) {
 }
 
 TEST(SynthSequenceTest, PeopleCoverTenToFiftyPercentInWalkingPresets) {
-  for (const std::string preset : {"walking_xyz", "walking_static", "walking_rpy",
-                                   "walking_halfsphere"}) {
+  for (const std::string preset :
+       {"walking_xyz", "walking_static", "walking_rpy", "walking_halfsphere"}) {
     SyntheticSequence seq(Opts(preset, 1, false));
     double sum = 0;
     int n = 0, max_people = 0;
@@ -184,7 +184,8 @@ TEST(SynthSequenceTest, DepthNoiseAndHolesFollowTheSensorModel) {
         ++holes;
         continue;
       }
-      const double sigma = model.sigma0 + model.sigma2 * (z - model.z_offset) * (z - model.z_offset);
+      const double sigma =
+          model.sigma0 + model.sigma2 * (z - model.z_offset) * (z - model.z_offset);
       const double e = (raw / 5000.0 - z) / sigma;
       sum_sq_norm += e * e;
       ++valid;
@@ -227,7 +228,8 @@ TEST(SynthSequenceTest, StampsAndMotionAreRealistic) {
   }
   // The loop returns to its start.
   synth::CameraPath loop("loop", 1);
-  const Rigid3d end = loop.WorldFromCam(0).Inverse() * loop.WorldFromCam(synth::CameraPath::kLoopPeriod);
+  const Rigid3d end =
+      loop.WorldFromCam(0).Inverse() * loop.WorldFromCam(synth::CameraPath::kLoopPeriod);
   EXPECT_LT(end.translation().norm(), 1e-9);
   EXPECT_LT(end.RotationAngle(), 1e-9);
 }

@@ -24,8 +24,8 @@ std::string Slurp(const fs::path& p) {
 }
 
 fs::path TempDir(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() /
-                       ("detslam_synth_" + name + "_" + std::to_string(::getpid()));
+  const fs::path dir =
+      fs::temp_directory_path() / ("detslam_synth_" + name + "_" + std::to_string(::getpid()));
   fs::remove_all(dir);
   return dir;
 }
@@ -51,9 +51,10 @@ TEST(SynthWriterTest, WritesTumLayoutDeterministically) {
     EXPECT_TRUE(gt[k].world_from_cam.Matrix().isApprox(seq.WorldFromCam(k).Matrix(), 1e-8));
     const std::string stamp = seq.StampOf(k).ToString();
     const cv::Mat rgb = cv::imread((a / "rgb" / (stamp + ".png")).string(), cv::IMREAD_UNCHANGED);
-    const cv::Mat depth = cv::imread((a / "depth" / (seq.DepthStampOf(k).ToString() + ".png")).string(),
-                                     cv::IMREAD_UNCHANGED);
-    const cv::Mat mask = cv::imread((a / "masks" / (stamp + ".png")).string(), cv::IMREAD_UNCHANGED);
+    const cv::Mat depth = cv::imread(
+        (a / "depth" / (seq.DepthStampOf(k).ToString() + ".png")).string(), cv::IMREAD_UNCHANGED);
+    const cv::Mat mask =
+        cv::imread((a / "masks" / (stamp + ".png")).string(), cv::IMREAD_UNCHANGED);
     ASSERT_FALSE(rgb.empty());
     ASSERT_FALSE(depth.empty());
     ASSERT_FALSE(mask.empty());
@@ -68,7 +69,8 @@ TEST(SynthWriterTest, WritesTumLayoutDeterministically) {
   int entries = 0;
   while (std::getline(rgb_txt, line)) {
     if (line.empty() || line[0] == '#') continue;
-    EXPECT_EQ(line, seq.StampOf(entries).ToString() + " rgb/" + seq.StampOf(entries).ToString() + ".png");
+    EXPECT_EQ(line,
+              seq.StampOf(entries).ToString() + " rgb/" + seq.StampOf(entries).ToString() + ".png");
     ++entries;
   }
   EXPECT_EQ(entries, 4);

@@ -56,7 +56,8 @@ void TextMarks(cv::Mat& img, const cv::Rect& area, const cv::Scalar& ink, Rng& r
   for (int y = area.y + line_h; y + stroke < area.y + area.height - line_h / 2;
        y += line_h + line_h / 2) {
     int x = area.x + line_h / 2;
-    const int x_end = area.x + area.width - line_h / 2 - static_cast<int>(rng.Uniform(0, area.width * 0.3));
+    const int x_end =
+        area.x + area.width - line_h / 2 - static_cast<int>(rng.Uniform(0, area.width * 0.3));
     while (x < x_end) {
       const int word = std::max(2, static_cast<int>(line_h * rng.Uniform(0.8, 4.0)));
       const int len = std::min(word, x_end - x);
@@ -73,11 +74,13 @@ void TextMarks(cv::Mat& img, const cv::Rect& area, const cv::Scalar& ink, Rng& r
   }
 }
 
-// Multi-scale clutter: rectangles (some with text), blobs and ticks, `per_m2` items per square metre
-// at the smallest scale; larger scales get proportionally fewer items.
+// Multi-scale clutter: rectangles (some with text), blobs and ticks, `per_m2` items per square
+// metre at the smallest scale; larger scales get proportionally fewer items.
 void Clutter(cv::Mat& img, const cv::Scalar& base, double per_m2, double min_contrast, Rng& rng) {
   const double area_m2 = img.cols * img.rows / (kTexelsPerMetre * kTexelsPerMetre);
-  struct Scale { double min_m, max_m, density; };
+  struct Scale {
+    double min_m, max_m, density;
+  };
   const Scale scales[] = {{0.15, 0.45, 0.06}, {0.04, 0.14, 0.3}, {0.012, 0.04, 1.0}};
   for (const Scale& s : scales) {
     const int count = static_cast<int>(std::ceil(per_m2 * s.density * area_m2));
@@ -86,8 +89,8 @@ void Clutter(cv::Mat& img, const cv::Scalar& base, double per_m2, double min_con
       const int h = std::max(2, static_cast<int>(rng.Uniform(s.min_m, s.max_m) * kTexelsPerMetre));
       const int x = rng.UniformInt(-w / 2, std::max(0, img.cols - w / 2));
       const int y = rng.UniformInt(-h / 2, std::max(0, img.rows - h / 2));
-      const cv::Scalar colour = rng.Uniform() < 0.06 ? RandomColour(rng)
-                                                     : Contrasting(base, min_contrast, 75, rng);
+      const cv::Scalar colour =
+          rng.Uniform() < 0.06 ? RandomColour(rng) : Contrasting(base, min_contrast, 75, rng);
       const double kind = rng.Uniform();
       if (kind < 0.6) {
         cv::rectangle(img, cv::Rect(x, y, w, h), colour, cv::FILLED);
@@ -119,15 +122,36 @@ cv::Mat MakeSurfaceTexture(SurfaceKind kind, int width_px, int height_px, Rng& r
   cv::Mat img;
   cv::Scalar base;
   switch (kind) {
-    case SurfaceKind::kWall: base = Jitter(cv::Scalar(170, 190, 200), 25, rng); break;
-    case SurfaceKind::kFloor: base = Jitter(cv::Scalar(90, 95, 100), 20, rng); break;
-    case SurfaceKind::kCeiling: base = Jitter(cv::Scalar(215, 218, 220), 8, rng); break;
-    case SurfaceKind::kWood: base = Jitter(cv::Scalar(70, 120, 165), 25, rng); break;
-    case SurfaceKind::kCardboard: base = Jitter(cv::Scalar(95, 145, 185), 15, rng); break;
-    case SurfaceKind::kPoster: base = RandomColour(rng); break;
-    case SurfaceKind::kBooks: base = Jitter(cv::Scalar(60, 60, 60), 20, rng); break;
-    case SurfaceKind::kMetal: base = Jitter(cv::Scalar(140, 140, 135), 30, rng); break;
-    case SurfaceKind::kScreen: base = Jitter(cv::Scalar(35, 30, 30), 10, rng); break;
+    case SurfaceKind::kWall:
+      base = Jitter(cv::Scalar(170, 190, 200), 25, rng);
+      break;
+    case SurfaceKind::kFloor:
+      base = Jitter(cv::Scalar(90, 95, 100), 20, rng);
+      break;
+    case SurfaceKind::kCeiling:
+      base = Jitter(cv::Scalar(215, 218, 220), 8, rng);
+      break;
+    case SurfaceKind::kWood:
+      base = Jitter(cv::Scalar(70, 120, 165), 25, rng);
+      break;
+    case SurfaceKind::kCardboard:
+      base = Jitter(cv::Scalar(95, 145, 185), 15, rng);
+      break;
+    case SurfaceKind::kPoster:
+      base = RandomColour(rng);
+      break;
+    case SurfaceKind::kBooks:
+      base = Jitter(cv::Scalar(60, 60, 60), 20, rng);
+      break;
+    case SurfaceKind::kMetal:
+      base = Jitter(cv::Scalar(140, 140, 135), 30, rng);
+      break;
+    case SurfaceKind::kScreen:
+      base = Jitter(cv::Scalar(35, 30, 30), 10, rng);
+      break;
+    case SurfaceKind::kPlainWall:
+      base = Jitter(cv::Scalar(175, 192, 200), 15, rng);
+      break;
   }
   img = cv::Mat(h, w, CV_8UC3, base);
   const double m = kTexelsPerMetre;
@@ -169,8 +193,8 @@ cv::Mat MakeSurfaceTexture(SurfaceKind kind, int width_px, int height_px, Rng& r
       break;
     case SurfaceKind::kCardboard:
       Clutter(img, base, 90, 35, rng);
-      cv::rectangle(img, cv::Rect(0, h / 2 - static_cast<int>(0.025 * m), w,
-                                  static_cast<int>(0.05 * m)),
+      cv::rectangle(img,
+                    cv::Rect(0, h / 2 - static_cast<int>(0.025 * m), w, static_cast<int>(0.05 * m)),
                     Jitter(cv::Scalar(150, 170, 180), 20, rng), cv::FILLED);
       TextMarks(img, cv::Rect(w / 8, h / 8, w / 2, h / 4), cv::Scalar(30, 30, 30), rng);
       break;
@@ -186,7 +210,8 @@ cv::Mat MakeSurfaceTexture(SurfaceKind kind, int width_px, int height_px, Rng& r
         const int top = static_cast<int>(rng.Uniform(0.0, 0.35) * h);
         const cv::Scalar c = RandomColour(rng);
         cv::rectangle(img, cv::Rect(x, top, bw, h - top), c, cv::FILLED);
-        if (bw > 6) TextMarks(img, cv::Rect(x, top + h / 5, bw, h / 2), Contrasting(c, 60, 120, rng), rng);
+        if (bw > 6)
+          TextMarks(img, cv::Rect(x, top + h / 5, bw, h / 2), Contrasting(c, 60, 120, rng), rng);
         x += bw + rng.UniformInt(0, 3);
       }
       break;
@@ -197,6 +222,10 @@ cv::Mat MakeSurfaceTexture(SurfaceKind kind, int width_px, int height_px, Rng& r
       break;
     case SurfaceKind::kScreen:
       Clutter(img, base, 500, 60, rng);
+      break;
+    case SurfaceKind::kPlainWall:
+      AddLowFrequency(img, 10, rng);
+      Clutter(img, base, 8, 25, rng);
       break;
   }
   Grain(img, 3.0, rng);

@@ -19,6 +19,7 @@ enum class SurfaceKind {
   kBooks,      // shelf fronts: book spines of random widths and colours
   kMetal,      // cabinets, legs, monitor backs: brushed grey with labels and screws
   kScreen,     // monitor fronts: windows and text on a dark background
+  kPlainWall,  // freshly painted wall: uneven shading and a few small marks only
 };
 
 // Texels per metre of the precomputed textures.

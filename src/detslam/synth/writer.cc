@@ -39,6 +39,8 @@ std::string Describe(const SynthOptions& o) {
   if (!o.people) os << " --no-people";
   if (!o.people_dir.empty()) os << " --people " << o.people_dir;
   if (o.motion_blur) os << " --blur";
+  if (o.depth_scale_bias != 0.0) os << " --depth-scale-bias " << o.depth_scale_bias;
+  if (o.HasCut()) os << " --cut " << o.cut_begin << ":" << o.cut_end;
   return os.str();
 }
 
@@ -67,23 +69,28 @@ SynthStats WriteSequence(const SynthOptions& options, const std::string& out_dir
   std::error_code ec;
   for (const char* sub : {"rgb", "depth", "masks"}) {
     fs::create_directories(fs::path(out_dir) / sub, ec);
-    if (ec) throw InputError(out_dir, 0, std::string("cannot create folder ") + sub + ": " + ec.message());
+    if (ec)
+      throw InputError(out_dir, 0,
+                       std::string("cannot create folder ") + sub + ": " + ec.message());
   }
   const std::string header = Describe(options);
   std::ostringstream rgb_txt, depth_txt, inst_txt;
   rgb_txt << "# color images\n# file: '" << header << "'\n# timestamp filename\n";
   depth_txt << "# depth maps\n# file: '" << header << "'\n# timestamp filename\n";
-  inst_txt << "# moving-object instances per frame (ground truth of the synthetic sequence)\n"
-           << "# file: '" << header << "'\n"
-           << "# timestamp id class score x y w h\n"
-           << "# timestamp: colour image stamp; id: value of the object's pixels in\n"
-           << "# masks/<timestamp>.png (16-bit, 0 = static scene); class: COCO name; score: 1 (truth);\n"
-           << "# x y w h: bounding box of the visible pixels (pixels, top-left origin)\n";
+  inst_txt
+      << "# moving-object instances per frame (ground truth of the synthetic sequence)\n"
+      << "# file: '" << header << "'\n"
+      << "# timestamp id class score x y w h\n"
+      << "# timestamp: colour image stamp; id: value of the object's pixels in\n"
+      << "# masks/<timestamp>.png (16-bit, 0 = static scene); class: COCO name; score: 1 (truth);\n"
+      << "# x y w h: bounding box of the visible pixels (pixels, top-left origin)\n";
   Trajectory gt;
   SynthStats stats;
-  stats.frames = seq.size();
   double coverage_sum = 0, fast_sum = 0;
   for (int k = 0; k < seq.size(); ++k) {
+    // --cut: the camera keeps moving through the cut frames, none of their files are written.
+    if (options.HasCut() && k >= options.cut_begin && k < options.cut_end) continue;
+    ++stats.frames;
     const auto t0 = Clock::now();
     const SynthFrame f = seq.Render(k);
     stats.render_seconds += Since(t0);
@@ -95,7 +102,8 @@ SynthStats WriteSequence(const SynthOptions& options, const std::string& out_dir
     cv::parallel_for_(cv::Range(0, 3), [&](const cv::Range& r) {
       for (int i = r.start; i < r.end; ++i) bytes[i] = EncodePng(*images[i], names[i]);
     });
-    for (int i = 0; i < 3; ++i) WriteBytesAtomically((fs::path(out_dir) / names[i]).string(), bytes[i]);
+    for (int i = 0; i < 3; ++i)
+      WriteBytesAtomically((fs::path(out_dir) / names[i]).string(), bytes[i]);
     rgb_txt << stamp << " " << names[0] << "\n";
     depth_txt << dstamp << " " << names[1] << "\n";
     for (const SynthInstance& in : f.instances) {
@@ -113,19 +121,17 @@ SynthStats WriteSequence(const SynthOptions& options, const std::string& out_dir
     stats.total_seconds -= measure;  // statistics are not part of the generator's speed
     if ((k + 1) % 50 == 0 || k + 1 == seq.size()) {
       spdlog::info("synth {}: frame {}/{} ({:.1f} fps)", options.preset, k + 1, seq.size(),
-                   (k + 1) / std::max(1e-9, Since(start) + stats.total_seconds));
+                   stats.frames / std::max(1e-9, Since(start) + stats.total_seconds));
     }
   }
   auto write_text = [&](const std::string& name, const std::string& text) {
-    WriteFileAtomically((fs::path(out_dir) / name).string(),
-                        [&](std::ostream& os) { os << text; });
+    WriteFileAtomically((fs::path(out_dir) / name).string(), [&](std::ostream& os) { os << text; });
   };
   write_text("rgb.txt", rgb_txt.str());
   write_text("depth.txt", depth_txt.str());
   write_text("masks/instances.txt", inst_txt.str());
   WriteTumTrajectory((fs::path(out_dir) / "groundtruth.txt").string(), gt,
-                     "ground truth trajectory (world_from_camera)\nfile: '" + header +
-                         "'");
+                     "ground truth trajectory (world_from_camera)\nfile: '" + header + "'");
   WriteSynthSettings((fs::path(out_dir) / "settings.yaml").string(), seq.camera());
   stats.total_seconds += Since(start);
   stats.render_fps = stats.frames / std::max(1e-9, stats.render_seconds);

@@ -2,7 +2,9 @@
 //   rgb/<stamp>.png  depth/<stamp>.png (16-bit, metres * 5000, 0 = missing)  rgb.txt depth.txt
 //   groundtruth.txt (TUM, world_from_camera per frame)  masks/<stamp>.png (16-bit instance ids)
 //   masks/instances.txt  settings.yaml (ORB-SLAM3 v1.0 style, TUM fr3 camera)
-// Every file is written atomically; the same options give byte-identical files.
+// Every file is written atomically; the same options give byte-identical files. With a cut
+// (options.cut_begin/cut_end) the cut frames are absent from every file and folder (the rest keep
+// their true stamps and poses: a gap in time, a jump in pose).
 #pragma once
 
 #include <opencv2/core.hpp>
@@ -14,14 +16,14 @@ namespace detslam {
 
 // What writing a sequence measured.
 struct SynthStats {
-  int frames = 0;                  // frames written
-  double render_seconds = 0;       // time spent rendering (scene, people, sensor effects)
-  double total_seconds = 0;        // rendering + PNG encoding + writing files
-  double render_fps = 0;           // frames / render_seconds
-  double total_fps = 0;            // frames / total_seconds
-  double mean_fast_corners = 0;    // mean cv::FAST (threshold 20, non-max) corners, sampled frames
-  double mean_coverage = 0;        // mean fraction of pixels covered by people, all frames
-  int sampled_frames = 0;          // frames the FAST count was taken on
+  int frames = 0;                // frames written
+  double render_seconds = 0;     // time spent rendering (scene, people, sensor effects)
+  double total_seconds = 0;      // rendering + PNG encoding + writing files
+  double render_fps = 0;         // frames / render_seconds
+  double total_fps = 0;          // frames / total_seconds
+  double mean_fast_corners = 0;  // mean cv::FAST (threshold 20, non-max) corners, sampled frames
+  double mean_coverage = 0;      // mean fraction of pixels covered by people, all frames
+  int sampled_frames = 0;        // frames the FAST count was taken on
 };
 
 // Renders and writes the sequence into `out_dir` (created if missing; existing files of the same
