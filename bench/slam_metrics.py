@@ -6,9 +6,10 @@ Usage:
   slam_metrics.py field FILE.json key.path        -> prints the value
   slam_metrics.py drift groundtruth.txt trajectory.txt -> prints 'drift_m path_m'
   slam_metrics.py kidnap run.json groundtruth.txt trajectory.txt FRAME
-      -> prints 'frames_lost reloc_frame error_m': after the jump at input frame FRAME, how many
-         frames went by until a frame was relocalised (-1 -1 -1 if none was), that frame's index and
-         its position error (first poses aligned, as for the drift)
+      -> prints 'frames_lost frame method error_m': after the jump at input frame FRAME, how many
+         frames went by until one was tracked again (-1 -1 - -1 if none was), that frame's index,
+         how it was tracked (motion, reference, relocalization) and its position error (first
+         poses aligned, as for the drift)
 """
 import json
 import math
@@ -99,17 +100,15 @@ def kidnap(run_json, gt_path, est_path, jump_frame):
     with open(run_json) as f:
         frames = json.load(f)["per_frame"]
     for r in frames:
-        if r["index"] < jump_frame:
-            continue
-        if r["tracked"] and r["method"] == "relocalization":
+        if r["index"] >= jump_frame and r["tracked"]:
             err = position_error_at(gt_path, est_path, r["stamp"])
-            return r["index"] - jump_frame, r["index"], err
-    return -1, -1, -1
+            return r["index"] - jump_frame, r["index"], r["method"], err
+    return -1, -1, "-", -1
 
 
 def main():
     if len(sys.argv) == 6 and sys.argv[1] == "kidnap":
-        print("%d %d %.4f" % kidnap(sys.argv[2], sys.argv[3], sys.argv[4], int(sys.argv[5])))
+        print("%d %d %s %.4f" % kidnap(sys.argv[2], sys.argv[3], sys.argv[4], int(sys.argv[5])))
         return
     if len(sys.argv) == 4 and sys.argv[1] == "field":
         v = get(sys.argv[2], sys.argv[3])

@@ -113,6 +113,7 @@ bool Tracker::Relocalize(const Map& map, Frame* frame) {
     for (auto it = map.keyframes().rbegin(); it != map.keyframes().rend(); ++it)
       kfs.push_back(it->first);
   }
+  spdlog::debug("frame {}: {} relocalisation candidates", frame->index, kfs.size());
   for (KeyFrameId kf_id : kfs) {
     const std::vector<LandmarkId> matched = MatchKeyFrameLandmarks(
         map.keyframe(kf_id), f, kRelocalizationRatio, kThLow,
@@ -128,6 +129,7 @@ bool Tracker::Relocalize(const Map& map, Frame* frame) {
       px.push_back(f.undist[i]);
       sigma2.push_back(map.scale().level_sigma2[static_cast<size_t>(f.keypoints[i].octave)]);
     }
+    spdlog::debug("  keyframe {}: {} matches", kf_id, kp_index.size());
     if (kp_index.size() < kMinRelocalizationMatches) continue;
     RansacOptions ro;
     const PnpResult pnp = SolvePnpRansac(camera_, pts, px, sigma2, ro, rng_);
@@ -139,6 +141,7 @@ bool Tracker::Relocalize(const Map& map, Frame* frame) {
     frame->cam_from_world = pnp.cam_from_world;
     scratch_.ClearTemporaryMatches();
     int inliers = OptimizeFramePose(map, frame, false);
+    spdlog::debug("  keyframe {}: PnP {} inliers, optimised {}", kf_id, pnp.num_inliers, inliers);
     if (inliers < kMinRelocalizationPnpInliers) continue;
     if (inliers < kRelocalizationInliers) {
       // Widen with the keyframe's neighbourhood by projection.
