@@ -18,33 +18,18 @@
 #include "detslam/synth/camera_path.h"
 #include "detslam/synth/scene.h"
 #include "detslam/synth/sequence.h"
+#include "detslam/synth/synth_test_util.h"
 #include "detslam/synth/writer.h"
 
 namespace detslam {
 namespace {
 
 namespace fs = std::filesystem;
-
-SynthOptions Opts(const std::string& preset, uint64_t seed = 1, bool noise = true) {
-  SynthOptions o;
-  o.preset = preset;
-  o.seed = seed;
-  o.sensor_noise = noise;
-  return o;
-}
-
-std::string Slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream os;
-  os << in.rdbuf();
-  return os.str();
-}
+using synth_test::Opts;
+using synth_test::Slurp;
 
 fs::path TempDir(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() /
-                       ("detslam_synth_place_" + name + "_" + std::to_string(::getpid()));
-  fs::remove_all(dir);
-  return dir;
+  return synth_test::TempDir("detslam_synth_place_", name);
 }
 
 // The error message of Check, or "" if the options are valid.

@@ -8,18 +8,13 @@
 #include "detslam/synth/camera_path.h"
 #include "detslam/synth/scene.h"
 #include "detslam/synth/sequence.h"
+#include "detslam/synth/synth_test_util.h"
 #include "detslam/synth/writer.h"
 
 namespace detslam {
 namespace {
 
-SynthOptions Opts(const std::string& preset, uint64_t seed = 1, bool noise = true) {
-  SynthOptions o;
-  o.preset = preset;
-  o.seed = seed;
-  o.sensor_noise = noise;
-  return o;
-}
+using synth_test::Opts;
 
 std::string Png(const cv::Mat& m) {
   std::vector<uchar> buf;

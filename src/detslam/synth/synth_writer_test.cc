@@ -9,26 +9,16 @@
 #include "detslam/io/settings.h"
 #include "detslam/io/trajectory.h"
 #include "detslam/synth/sequence.h"
+#include "detslam/synth/synth_test_util.h"
 #include "detslam/synth/writer.h"
 
 namespace detslam {
 namespace {
 
 namespace fs = std::filesystem;
+using synth_test::Slurp;
 
-std::string Slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream os;
-  os << in.rdbuf();
-  return os.str();
-}
-
-fs::path TempDir(const std::string& name) {
-  const fs::path dir =
-      fs::temp_directory_path() / ("detslam_synth_" + name + "_" + std::to_string(::getpid()));
-  fs::remove_all(dir);
-  return dir;
-}
+fs::path TempDir(const std::string& name) { return synth_test::TempDir("detslam_synth_", name); }
 
 TEST(SynthWriterTest, WritesTumLayoutDeterministically) {
   SynthOptions o;
