@@ -68,6 +68,32 @@ TEST(IntegrationVocabCli, TrainThenInfoDeterministic) {
   fs::remove_all(dir);
 }
 
+// `detslam run` with a vocabulary it cannot use stops with the file named, before writing outputs;
+// with none it runs without place recognition and says so in run.json.
+TEST(IntegrationVocabCli, RunNamesABadVocabularyAndRunsWithNone) {
+  const fs::path dir =
+      fs::temp_directory_path() / ("detslam_it_vocab_run_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  const fs::path log = dir / "log.txt";
+  fs::create_directories(dir);
+  ASSERT_EQ(RunCli("synth --preset static --frames 3 --out '" + (dir / "seq").string() + "'", log),
+            0)
+      << ReadFileBytes(log);
+  const std::string run =
+      "run --no-progress --segmenter none --dataset '" + (dir / "seq").string() + "' --out '";
+  std::ofstream(dir / "bad.dslvoc") << "DSLMVOC\0garbage";
+  EXPECT_EQ(RunCli(run + (dir / "out1").string() + "' --vocabulary '" +
+                       (dir / "bad.dslvoc").string() + "'",
+                   log),
+            1);
+  EXPECT_THAT(ReadFileBytes(log), HasSubstr("error: " + (dir / "bad.dslvoc").string()));
+  EXPECT_FALSE(fs::exists(dir / "out1" / "trajectory.txt"));
+  ASSERT_EQ(RunCli(run + (dir / "out2").string() + "' --vocabulary none", log), 0)
+      << ReadFileBytes(log);
+  EXPECT_THAT(ReadFileBytes(dir / "out2" / "run.json"), HasSubstr("\"vocabulary\": \"none\""));
+  fs::remove_all(dir);
+}
+
 // The shipped vocabulary is what its recipe (data/vocabulary/README.md) builds, byte for byte: its
 // training images are the Debian packages' photographs and ../shared's TUM frames.
 TEST(DataVocabulary, ShippedFileIsReproducible) {
