@@ -6,7 +6,7 @@
 # PASS/FAIL lines and the plot docs/place_reloc_time.svg into docs/BENCHMARKS.md (section place)
 # via bench/update_section.py. About 10 minutes on 2 cores with the defaults; progress on stderr.
 # Usage: bench/bench_place.sh [path/to/bench_place]   (default build/bench/bench_place)
-#   (env: SIZES=250,500,1000,2000,5000 STRIDE=8 KF_PER_SEQ=50 QUERIES_PER_SEQ=30 REPEATS=3
+#   (env: SIZES=250,500,1000,2000,5000 STRIDE=8 KF_PER_SEQ=50 QUERIES_PER_SEQ=30 REPEATS=5
 #         COVISIBILITY=1 JSON=path to keep the raw results)
 set -euo pipefail
 here="$(cd "$(dirname "$0")" && pwd)"
@@ -16,7 +16,7 @@ sizes="${SIZES:-250,500,1000,2000,5000}"
 stride="${STRIDE:-8}"
 kf_per_seq="${KF_PER_SEQ:-50}"
 queries="${QUERIES_PER_SEQ:-30}"
-repeats="${REPEATS:-3}"
+repeats="${REPEATS:-5}"
 covis="${COVISIBILITY:-1}"
 work="$(mktemp -d)"
 trap 'rm -rf "$work"' EXIT
