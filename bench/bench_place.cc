@@ -259,6 +259,7 @@ nlohmann::json PlaceBench::Measure() {
   TrackerOptions tracker_options;
   tracker_options.seed = o_.seed;
   std::vector<double> total_ms, total_median_ms, cand_ms, n_cands, errors_cm;
+  std::vector<double> index_entries, sharing_keyframes, query_words;
   int successes = 0, same_room = 0;
   nlohmann::json per_query = nlohmann::json::array();
   for (const QueryFrame& q : queries_) {
@@ -279,11 +280,27 @@ nlohmann::json PlaceBench::Measure() {
       result = tracker.RelocalizeFrame(map_, &frame);
       t_total.push_back(MsSince(t1));
     }
-    nlohmann::json j = {
-        {"sequence", q.sequence},          {"frame", q.frame},
-        {"total_ms", Min(t_total)},        {"total_ms_median_of_runs", Median(t_total)},
-        {"candidates_ms", Min(t_cand)},    {"candidates", num_candidates},
-        {"success", result != kNoKeyFrame}};
+    // Size of the inverted-index work (untimed): entries on the query's words' lists, and the
+    // keyframes sharing at least one word with the query.
+    size_t entries = 0;
+    std::set<KeyFrameId> sharing;
+    for (const auto& word_weight : q.frame_data.features->bow) {
+      const std::vector<KeyFrameId> ids = map_.place_index().KeyFramesWithWord(word_weight.first);
+      entries += ids.size();
+      sharing.insert(ids.begin(), ids.end());
+    }
+    index_entries.push_back(static_cast<double>(entries));
+    query_words.push_back(static_cast<double>(q.frame_data.features->bow.size()));
+    sharing_keyframes.push_back(static_cast<double>(sharing.size()));
+    nlohmann::json j = {{"sequence", q.sequence},
+                        {"frame", q.frame},
+                        {"total_ms", Min(t_total)},
+                        {"total_ms_median_of_runs", Median(t_total)},
+                        {"candidates_ms", Min(t_cand)},
+                        {"candidates", num_candidates},
+                        {"success", result != kNoKeyFrame},
+                        {"index_entries", entries},
+                        {"keyframes_sharing_a_word", sharing.size()}};
     total_ms.push_back(Min(t_total));
     total_median_ms.push_back(Median(t_total));
     cand_ms.push_back(Min(t_cand));
@@ -319,6 +336,9 @@ nlohmann::json PlaceBench::Measure() {
            {{"median", Median(total_median_ms)}, {"p90", Percentile(total_median_ms, 0.9)}}},
           {"candidates_ms", {{"median", Median(cand_ms)}, {"p90", Percentile(cand_ms, 0.9)}}},
           {"candidates", {{"median", Median(n_cands)}, {"max", Percentile(n_cands, 1.0)}}},
+          {"query_words", {{"median", Median(query_words)}}},
+          {"index_entries", {{"median", Median(index_entries)}}},
+          {"keyframes_sharing_a_word", {{"median", Median(sharing_keyframes)}}},
           {"success_rate", successes / n},
           {"successes", successes},
           {"same_room", same_room},

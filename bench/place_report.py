@@ -182,6 +182,20 @@ def markdown(result):
     out.append("")
     out.append("Same room: successes relocalised against a keyframe of the query's own room "
                "(seed).")
+    out.append("")
+    out.append("Inverted-index work per query (medians, counted outside the timing): entries on "
+               "the lists of the query's words,")
+    out.append("which `KeyFrameDatabase::Query` visits one by one, and keyframes sharing at least "
+               "one word with the query.")
+    out.append("")
+    out.append("| map (synthetic) | words in a query | index entries visited | keyframes sharing a "
+               "word | candidates median ms |")
+    out.append("|---|---:|---:|---:|---:|")
+    for n, s in sorted(by_size(result).items()):
+        out.append(f"| synthetic, {n} keyframes | {s['query_words']['median']:.0f} | "
+                   f"{s['index_entries']['median']:.0f} | "
+                   f"{s['keyframes_sharing_a_word']['median']:.0f} | "
+                   f"{fmt(s['candidates_ms']['median'])} |")
     m1000, ratio, ok1, ok2 = verdict(result)
 
     def judged(value, ok):
