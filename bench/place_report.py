@@ -44,8 +44,8 @@ def render_svg(result):
         ("median, candidates alone", "#3a9d4a", [s["candidates_ms"]["median"] for _, s in sizes],
          ""),
     ]
-    width, height = 780, 420
-    left, right, top, bottom = 70, 240, 50, 60
+    width, height = 780, 450
+    left, right, top, bottom = 70, 240, 80, 60
     pw, ph = width - left - right, height - top - bottom
     hi = max([TARGET_MS] + [v for *_, vals, _ in series for v in vals]) * 1.1
     step = 10 ** math.floor(math.log10(hi / 4))
@@ -106,10 +106,10 @@ def render_svg(result):
         s.append(f'<polyline points="{pts}" fill="none" stroke="{colour}" stroke-width="2"/>')
         for n, v in zip(xs, vals):
             s.append(f'<circle cx="{x(n):.1f}" cy="{y(v):.1f}" r="3.5" fill="{colour}"/>')
-        ly = top + 40 + 20 * i
-        s.append(f'<line x1="{left + pw + 8}" y1="{ly}" x2="{left + pw + 30}" y2="{ly}" '
+        lx = left + 200 * i  # legend: one row between the subtitle and the plot
+        s.append(f'<line x1="{lx}" y1="{top - 18}" x2="{lx + 22}" y2="{top - 18}" '
                  f'stroke="{colour}" stroke-width="2"/>')
-        s.append(f'<text x="{left + pw + 36}" y="{ly + 4}">{html.escape(label)}</text>')
+        s.append(f'<text x="{lx + 28}" y="{top - 14}">{html.escape(label)}</text>')
     s.append("</svg>")
     return "\n".join(s) + "\n"
 
