@@ -25,11 +25,13 @@ def by_size(result):
     return {s["keyframes"]: s for s in result["sizes"]}
 
 
-def verdict(result):
-    """(median at 1000, ratio 5000/1000, pass 1000, pass ratio); None where not measured."""
+def verdict(result, key="total_ms"):
+    """(median at 1000, ratio 5000/1000, pass 1000, pass ratio) of the per-query times `key`
+    (total_ms: each query's fastest run; total_ms_median_of_runs: its median run); None where
+    not measured."""
     sizes = by_size(result)
-    m1000 = sizes[1000]["total_ms"]["median"] if 1000 in sizes else None
-    m5000 = sizes[5000]["total_ms"]["median"] if 5000 in sizes else None
+    m1000 = sizes[1000][key]["median"] if 1000 in sizes else None
+    m5000 = sizes[5000][key]["median"] if 5000 in sizes else None
     ratio = m5000 / m1000 if m1000 and m5000 is not None else None
     return (m1000, ratio, m1000 is not None and m1000 <= TARGET_MS,
             ratio is not None and ratio <= TARGET_RATIO)
@@ -196,18 +198,18 @@ def markdown(result):
                    f"{s['index_entries']['median']:.0f} | "
                    f"{s['keyframes_sharing_a_word']['median']:.0f} | "
                    f"{fmt(s['candidates_ms']['median'])} |")
-    m1000, ratio, ok1, ok2 = verdict(result)
-
     def judged(value, ok):
         return "not measured" if value is None else ("PASS" if ok else "FAIL")
 
     out.append("")
-    out.append("| target | measured | result |")
-    out.append("|---|---:|---|")
-    out.append(f"| median <= {TARGET_MS:g} ms at 1000 keyframes (synthetic) | {fmt(m1000)} ms | "
-               f"{judged(m1000, ok1)} |")
-    out.append(f"| median(5000) / median(1000) <= {TARGET_RATIO:g} (synthetic) | {fmt(ratio)} | "
-               f"{judged(ratio, ok2)} |")
+    out.append("| target | per query | measured | result |")
+    out.append("|---|---|---:|---|")
+    for key, label in (("total_ms", "fastest run"), ("total_ms_median_of_runs", "median run")):
+        m1000, ratio, ok1, ok2 = verdict(result, key)
+        out.append(f"| median <= {TARGET_MS:g} ms at 1000 keyframes (synthetic) | {label} | "
+                   f"{fmt(m1000)} ms | {judged(m1000, ok1)} |")
+        out.append(f"| median(5000) / median(1000) <= {TARGET_RATIO:g} (synthetic) | {label} | "
+                   f"{fmt(ratio)} | {judged(ratio, ok2)} |")
     out.append("")
     out.append(f"![relocalisation time against map size]({SVG_NAME})")
     return "\n".join(out) + "\n"

@@ -2,32 +2,50 @@
 
 #include <algorithm>
 #include <cmath>
-#include <unordered_map>
 
 namespace detslam {
+
+int32_t KeyFrameDatabase::SlotOf(Id id) {
+  int32_t slot;
+  if (!free_slots_.empty()) {
+    slot = free_slots_.back();
+    free_slots_.pop_back();
+    id_of_slot_[static_cast<size_t>(slot)] = id;
+  } else {
+    slot = static_cast<int32_t>(id_of_slot_.size());
+    id_of_slot_.push_back(id);
+  }
+  slot_of_[id] = slot;
+  return slot;
+}
 
 void KeyFrameDatabase::Insert(Id id, const BowVector& bow) {
   Erase(id);
   bows_[id] = bow;
+  const int32_t slot = SlotOf(id);
   const double norm = L1Norm(bow);
   if (norm <= 0.0) return;
   for (const auto& [word, weight] : bow) {
-    if (weight != 0.0) index_[word].emplace_back(id, std::abs(weight) / norm);
+    if (weight == 0.0 || word < 0) continue;
+    if (static_cast<size_t>(word) >= index_.size()) index_.resize(static_cast<size_t>(word) + 1);
+    index_[static_cast<size_t>(word)].push_back({slot, std::abs(weight) / norm});
   }
 }
 
 void KeyFrameDatabase::Erase(Id id) {
   auto it = bows_.find(id);
   if (it == bows_.end()) return;
+  const int32_t slot = slot_of_.at(id);
   for (const auto& entry : it->second) {
-    auto list = index_.find(entry.first);
-    if (list == index_.end()) continue;
-    auto& v = list->second;
-    v.erase(std::remove_if(v.begin(), v.end(), [id](const auto& e) { return e.first == id; }),
+    if (entry.first < 0 || static_cast<size_t>(entry.first) >= index_.size()) continue;
+    auto& v = index_[static_cast<size_t>(entry.first)];
+    v.erase(std::remove_if(v.begin(), v.end(), [slot](const Posting& p) { return p.slot == slot; }),
             v.end());
-    if (v.empty()) index_.erase(list);
   }
   bows_.erase(it);
+  slot_of_.erase(id);
+  id_of_slot_[static_cast<size_t>(slot)] = -1;
+  free_slots_.push_back(slot);
 }
 
 std::vector<KeyFrameDatabase::Result> KeyFrameDatabase::Query(const BowVector& bow,
@@ -44,31 +62,33 @@ std::vector<KeyFrameDatabase::Result> KeyFrameDatabase::Query(const BowVector& b
   std::vector<Result> results;
   const double norm = L1Norm(bow);
   if (norm <= 0.0) return results;
-  std::unordered_map<Id, Result> by_id;
-  by_id.reserve(bows_.size());
+  // Accumulate over the postings of the query's words into dense per-slot sums.
+  std::vector<double> score(id_of_slot_.size(), 0.0);
+  std::vector<int> common(id_of_slot_.size(), 0);
   for (const auto& [word, weight] : bow) {
-    auto list = index_.find(word);
-    if (list == index_.end()) continue;
+    if (word < 0 || static_cast<size_t>(word) >= index_.size()) continue;
     const double q = std::abs(weight) / norm;
-    for (const auto& [id, w] : list->second) {
-      Result& r = by_id[id];
-      r.id = id;
-      r.score += std::min(q, w);
-      ++r.common_words;
+    for (const Posting& p : index_[static_cast<size_t>(word)]) {
+      score[static_cast<size_t>(p.slot)] += std::min(q, p.weight);
+      ++common[static_cast<size_t>(p.slot)];
     }
   }
   int max_common = 0;
-  for (const auto& [id, r] : by_id) {
-    if (options.exclude && options.exclude(id)) continue;
-    max_common = std::max(max_common, r.common_words);
+  for (size_t s = 0; s < common.size(); ++s) {
+    if (common[s] == 0 || (options.exclude && options.exclude(id_of_slot_[s]))) {
+      common[s] = 0;  // excluded slots take no further part
+      continue;
+    }
+    max_common = std::max(max_common, common[s]);
   }
   const double min_common = options.min_common_ratio * max_common;
-  for (const auto& [id, r] : by_id) {
-    if (options.exclude && options.exclude(id)) continue;
-    if (options.min_common_ratio > 0.0 && !(r.common_words > min_common)) continue;
-    Result kept = r;
-    kept.score = std::min(kept.score, 1.0);
-    if (kept.score > 0.0 && kept.score >= options.min_score) results.push_back(kept);
+  for (size_t s = 0; s < common.size(); ++s) {
+    if (common[s] == 0) continue;
+    if (options.min_common_ratio > 0.0 && !(common[s] > min_common)) continue;
+    const double clipped = std::min(score[s], 1.0);
+    if (clipped > 0.0 && clipped >= options.min_score) {
+      results.push_back({id_of_slot_[s], clipped, common[s]});
+    }
   }
   std::sort(results.begin(), results.end(), [](const Result& a, const Result& b) {
     return a.score != b.score ? a.score > b.score : a.id < b.id;
@@ -81,9 +101,10 @@ std::vector<KeyFrameDatabase::Result> KeyFrameDatabase::Query(const BowVector& b
 
 std::vector<KeyFrameDatabase::Id> KeyFrameDatabase::KeyFramesWithWord(int word) const {
   std::vector<Id> ids;
-  auto list = index_.find(word);
-  if (list == index_.end()) return ids;
-  for (const auto& e : list->second) ids.push_back(e.first);
+  if (word < 0 || static_cast<size_t>(word) >= index_.size()) return ids;
+  for (const Posting& p : index_[static_cast<size_t>(word)]) {
+    ids.push_back(id_of_slot_[static_cast<size_t>(p.slot)]);
+  }
   return ids;
 }
 

@@ -1,11 +1,14 @@
-// Inverted index over keyframes' bag-of-words vectors: word -> (keyframe id, weight), so that a
-// query scores only the keyframes that share at least one word with it.
+// Inverted index over keyframes' bag-of-words vectors: word -> (keyframe, weight), so that a
+// query scores only the keyframes that share at least one word with it. A query walks the lists
+// of its words once, accumulating into dense per-keyframe slots (no per-keyframe allocation), so
+// its cost is the number of postings it visits.
 #pragma once
 
 #include <cstddef>
 #include <cstdint>
 #include <functional>
 #include <map>
+#include <unordered_map>
 #include <utility>
 #include <vector>
 
@@ -50,8 +53,18 @@ class KeyFrameDatabase {
   std::vector<Id> KeyFramesWithWord(int word) const;
 
  private:
-  std::map<Id, BowVector> bows_;                             // every keyframe's vector
-  std::map<int, std::vector<std::pair<Id, double>>> index_;  // word -> (keyframe, weight)
+  // One posting of an inverted list: the keyframe's dense slot and its normalised word weight.
+  struct Posting {
+    int32_t slot;
+    double weight;
+  };
+  int32_t SlotOf(Id id);  // assigns a slot to a new keyframe (reusing freed ones, newest first)
+
+  std::map<Id, BowVector> bows_;             // every keyframe's vector
+  std::vector<std::vector<Posting>> index_;  // word -> postings, in insertion order
+  std::unordered_map<Id, int32_t> slot_of_;  // keyframe -> dense slot (accumulator index)
+  std::vector<Id> id_of_slot_;               // slot -> keyframe (-1: free)
+  std::vector<int32_t> free_slots_;
 };
 
 }  // namespace detslam
