@@ -1,5 +1,6 @@
-// detslam vocab: trains the bag-of-words vocabulary tree on a set of images (`train`) and describes
-// a vocabulary file (`info`); see src/detslam/place/vocabulary.h.
+// detslam vocab: trains the bag-of-words vocabulary tree on a set of images (`train`), describes a
+// vocabulary file (`info`) and prints the bag-of-words scores between images (`score`); see
+// src/detslam/place/vocabulary.h.
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
@@ -28,9 +29,8 @@ bool IsImageFile(const fs::path& p) {
 }
 
 // Image paths of an image file (itself), a folder (its image files, sorted by name) or a list
-// file: one image per line,
-// relative to the list's folder; blank lines and '#' comments skipped; of several fields on a line
-// (a TUM rgb.txt: "timestamp path") the last one is the path.
+// file: one image per line, relative to the list's folder; blank lines and '#' comments skipped;
+// of several fields on a line (a TUM rgb.txt: "timestamp path") the last one is the path.
 std::vector<std::string> ImagesOf(const std::string& source) {
   std::vector<std::string> images;
   std::error_code ec;
