@@ -15,7 +15,8 @@
 #     layouts);
 # and writes the tables into docs/BENCHMARKS.md (section place-loops) via bench/update_section.py.
 # Usage: bench/bench_loops.sh [path/to/detslam]
-#   (env: SEEDS="1 2 3", LOOP_FRAMES=1200, LONG_FRAMES=2250, PRESETS="static walking_xyz ...",
+#   (env: SEEDS="1 2 3", LOOP_FRAMES=1200, LONG_FRAMES=2250, DRIFT_BIAS=0.5,
+#    KIDNAP_TARGETS="880 900 920 940 980 1040", PRESETS="static walking_xyz ...",
 #    JOBS=2)
 set -euo pipefail
 here="$(cd "$(dirname "$0")" && pwd)"
@@ -24,6 +25,8 @@ bin="${1:-$root/build/bin/detslam}"
 seeds="${SEEDS:-1 2 3}"
 loop_frames="${LOOP_FRAMES:-1200}"
 long_frames="${LONG_FRAMES:-2250}"
+bias="${DRIFT_BIAS:-0.5}"
+kidnap_targets="${KIDNAP_TARGETS:-880 900 920 940 980 1040}"
 presets="${PRESETS:-static walking_xyz walking_static walking_rpy walking_halfsphere sitting_static}"
 jobs="${JOBS:-2}"
 work="$(mktemp -d)"
@@ -91,55 +94,62 @@ progress "A: loop preset, $loop_frames frames"
   echo
 } >>"$out"
 
-progress "B: drifting loop (loop_long, depth scale bias 0.3)"
-"$bin" synth --preset loop_long --seed 1 --frames "$long_frames" --depth-scale-bias 0.3 --out "$work/drift" >/dev/null 2>&1
+progress "B: drifting loop (loop_long, depth scale bias $bias)"
+"$bin" synth --preset loop_long --seed 1 --frames "$long_frames" --depth-scale-bias "$bias" --out "$work/drift" >/dev/null 2>&1
 {
-  echo "### B. Drifting loop: \`loop_long\` preset, seed 1, $long_frames frames (one 64 s lap, then on over its start), depth scale biased by up to 30 % (\`--depth-scale-bias 0.3\`)"
+  echo "### B. Drifting loop: \`loop_long\` preset, seed 1, $long_frames frames (one 64 s lap, then on over its start), depth scale biased by up to $(python3 -c "print(round($bias*100))") % (\`--depth-scale-bias $bias\`)"
   echo
-  echo "The written depth is scaled by 1 + 0.3 sin^2(pi k / (N-1)) while the ground truth stays true,"
+  echo "The written depth is scaled by 1 + $bias sin^2(pi k / (N-1)) while the ground truth stays true,"
   echo "so the estimate is far off where the camera comes back to its start (see the end drift with loop"
   echo "closing off): a detector that only looks within 1.5 m of the estimated position misses the loop."
   echo
   echo "$loop_header"
-  loop_rows "$work/drift" "loop_long, bias 0.3"
+  loop_rows "$work/drift" "loop_long, bias $bias"
   echo
 } >>"$out"
 
 progress "C: kidnapped camera"
 "$bin" synth --preset walking_halfsphere --seed 1 --no-people --cut 150:510 --out "$work/kidnap_hs" >/dev/null 2>&1
-"$bin" synth --preset loop --seed 1 --frames 1100 --cut 400:880 --out "$work/kidnap_loop" >/dev/null 2>&1
+for t in $kidnap_targets; do
+  "$bin" synth --preset loop --seed 1 --frames 1100 --cut "400:$t" --out "$work/kidnap_loop_$t" >/dev/null 2>&1
+done
 {
   echo "### C. Kidnapped camera: frames cut out of the sequence, so that the camera jumps"
   echo
   echo "- \`walking_halfsphere\`, seed 1, no people, frames 150..509 cut: the camera jumps to a pose it"
   echo "  reaches 12 s later, at least 0.53 m and 11.5 deg from every earlier pose, seeing mostly mapped ground."
-  echo "- \`loop\`, seed 1, 1100 frames, frames 400..879 cut: from a third of the lap to just before its"
-  echo "  start, a place mapped at the beginning and not covisible with the keyframes in use."
+  echo "- \`loop\`, seed 1, 1100 frames, frames 400..T-1 cut (T = $kidnap_targets): the camera jumps from a third"
+  echo "  of the lap to frame T, near the lap's start (frame 960, where the second lap retraces the first),"
+  echo "  a place mapped at the beginning and not covisible with the keyframes in use. The earlier T, the"
+  echo "  farther its viewpoint from every mapped one (columns: distance and angle to the nearest of"
+  echo "  frames 0..399; the closest pose by distance + angle / 30 deg per m)."
   echo
   echo "Frames after the jump until one is tracked again, how, and that frame's position error (first"
   echo "poses aligned). Relocalisation by bag-of-words candidates (default) against trying every"
   echo "keyframe by brute-force matching (no vocabulary)."
   echo
-  echo "| sequence | relocalisation | frames until tracked | tracked by | its position error cm | relocalisations | tracked | ATE RMSE mm |"
-  echo "|---|---|---:|---|---:|---:|---:|---:|"
+  echo "| sequence | jump target: nearest mapped pose | relocalisation | frames until tracked | tracked by | its position error cm | relocalisations | tracked | ATE RMSE mm |"
+  echo "|---|---|---|---:|---|---:|---:|---:|---:|"
 } >>"$out"
-for k in hs loop; do
-  run_eval "$work/kidnap_$k" "$work/kidnap_${k}_0" --segmenter none &
-  run_eval "$work/kidnap_$k" "$work/kidnap_${k}_1" --segmenter none --vocabulary none &
+kidnap_rows() {  # dataset_dir name jump_frame
+  local ds=$1 name=$2 jump=$3
+  run_eval "$ds" "${ds}_0" --segmenter none &
+  run_eval "$ds" "${ds}_1" --segmenter none --vocabulary none &
   wait
-  jump=150
-  [[ $k == loop ]] && jump=400
+  read -r dist angle < <(m nearest "$ds/groundtruth.txt" "$jump")
   for i in 0 1; do
-    o="$work/kidnap_${k}_$i"
-    read -r lost at how err < <(m kidnap "$o/run.json" "$work/kidnap_$k/groundtruth.txt" "$o/trajectory.txt" "$jump")
-    name="walking_halfsphere, cut 150:510"
-    [[ $k == loop ]] && name="loop, cut 400:880"
-    mode="bag-of-words candidates"
+    local o="${ds}_$i" mode="bag-of-words candidates"
     [[ $i == 1 ]] && mode="every keyframe (no vocabulary)"
-    echo "| $name | $mode | $lost | $how | $(python3 -c "print(f'{float($err)*100:.1f}')") |" \
-      "$(m field "$o/run.json" relocalizations) | $(m field "$o/run.json" frames_tracked)/$(m field "$o/run.json" frames) |" \
+    read -r lost at how err < <(m kidnap "$o/run.json" "$ds/groundtruth.txt" "$o/trajectory.txt" "$jump")
+    echo "| $name | $(python3 -c "print(f'{float($dist):.2f} m, {float($angle):.1f} deg')") | $mode | $lost | $how |" \
+      "$(python3 -c "print(f'{float($err)*100:.1f}')") | $(m field "$o/run.json" relocalizations) |" \
+      "$(m field "$o/run.json" frames_tracked)/$(m field "$o/run.json" frames) |" \
       "$(mm "$(m field "$o/eval.json" ate.rmse)") |" >>"$out"
   done
+}
+kidnap_rows "$work/kidnap_hs" "walking_halfsphere, cut 150:510" 150
+for t in $kidnap_targets; do
+  kidnap_rows "$work/kidnap_loop_$t" "loop, cut 400:$t" 400
 done
 echo >>"$out"
 
@@ -150,8 +160,12 @@ progress "D: false loops ($presets; seeds $seeds)"
   echo "Walking presets with people, ground-truth masks as segmenter (\`--segmenter gt\`); static"
   echo "presets without one. Any loop closed here is false."
   echo
-  echo "| sequence | seed | frames | tracked | loops closed | ATE RMSE mm |"
-  echo "|---|---:|---:|---:|---:|---:|"
+  echo "Loop candidates: those examined (bag-of-words groups), then how many passed 3-D rigid RANSAC"
+  echo "and the pose-only verification (run.json \`loop_detection\`); a verified loop still needs"
+  echo "3 agreeing keyframes before it is closed."
+  echo
+  echo "| sequence | seed | frames | tracked | loop candidates | passed rigid RANSAC | verified | loops closed | ATE RMSE mm |"
+  echo "|---|---:|---:|---:|---:|---:|---:|---:|---:|"
 } >>"$out"
 false_total=0
 n=0
@@ -172,10 +186,11 @@ for p in $presets lookalike; do
     loops=$(m field "$o/run.json" loops_closed)
     false_total=$((false_total + loops))
     echo "| $p | $s | $(m field "$o/run.json" frames) | $(m field "$o/run.json" frames_tracked) |" \
-      "$loops | $(mm "$(m field "$o/eval.json" ate.rmse)") |" >>"$out"
+      "$(m field "$o/run.json" loop_detection.candidates) | $(m field "$o/run.json" loop_detection.rigid_ransac) |" \
+      "$(m field "$o/run.json" loop_detection.verified) | $loops | $(mm "$(m field "$o/eval.json" ate.rmse)") |" >>"$out"
   done
 done
 printf '\nFalse loops accepted in all these runs: %s.\n' "$false_total" >>"$out"
 
-python3 "$here/update_section.py" place-loops "bench/bench_loops.sh (SEEDS=\"$seeds\" LOOP_FRAMES=$loop_frames LONG_FRAMES=$long_frames)" <"$out"
+python3 "$here/update_section.py" place-loops "bench/bench_loops.sh (SEEDS=\"$seeds\" LOOP_FRAMES=$loop_frames LONG_FRAMES=$long_frames DRIFT_BIAS=$bias KIDNAP_TARGETS=\"$kidnap_targets\")" <"$out"
 cat "$out"

@@ -10,6 +10,9 @@ Usage:
          frames went by until one was tracked again (-1 -1 - -1 if none was), that frame's index,
          how it was tracked (motion, reference, relocalization) and its position error (first
          poses aligned, as for the drift)
+  slam_metrics.py nearest groundtruth.txt ROW
+      -> prints 'distance_m angle_deg': how far ground-truth pose ROW (0-based row of the file) is
+         from the closest of rows 0..ROW-1, closest by distance + angle / (30 deg per m)
 """
 import json
 import math
@@ -106,10 +109,29 @@ def kidnap(run_json, gt_path, est_path, jump_frame):
     return -1, -1, "-", -1
 
 
+def nearest(gt_path, row):
+    gt = read_tum(gt_path)
+    if not 0 < row < len(gt):
+        raise SystemExit(f"{gt_path}: row {row} out of range (1..{len(gt) - 1})")
+    target = gt[row]
+    best = None
+    for g in gt[:row]:
+        d = math.dist(g[1:4], target[1:4])
+        dot = abs(sum(a * b for a, b in zip(g[4:8], target[4:8])))
+        angle = math.degrees(2 * math.acos(min(1.0, dot)))
+        score = d + angle / 30.0
+        if best is None or score < best[0]:
+            best = (score, d, angle)
+    return best[1], best[2]
+
+
 def main():
     if len(sys.argv) == 6 and sys.argv[1] == "kidnap":
         print("%d %d %s %.4f" % kidnap(sys.argv[2], sys.argv[3], sys.argv[4], int(sys.argv[5])))
         return
+    if len(sys.argv) == 4 and sys.argv[1] == "nearest":
+        print("%.4f %.2f" % nearest(sys.argv[2], int(sys.argv[3])))
+        return 0
     if len(sys.argv) == 4 and sys.argv[1] == "field":
         v = get(sys.argv[2], sys.argv[3])
         print(f"{v:.6g}" if isinstance(v, float) else v)

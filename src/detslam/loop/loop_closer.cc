@@ -3,6 +3,7 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <cmath>
 #include <set>
 #include <sstream>
 
@@ -22,8 +23,14 @@ namespace detslam {
 bool LoopClosingOptions::Check(std::string* error) const {
   std::ostringstream os;
   if (min_keyframe_gap < 1) os << "min_keyframe_gap must be >= 1; ";
+  if (candidate_window < 0) os << "candidate_window must be >= 0; ";
   if (!(candidate_radius_m >= 0)) os << "candidate_radius_m must be >= 0; ";
   if (consistent_detections < 1) os << "consistent_detections must be >= 1; ";
+  if (appearance_candidates < 1) os << "appearance_candidates must be >= 1; ";
+  if (confirm_min_matches < 1) os << "confirm_min_matches must be >= 1; ";
+  if (max_pending_misses < 1) os << "max_pending_misses must be >= 1; ";
+  if (!(revisit_max_correction_m >= 0) || !(revisit_max_correction_deg >= 0))
+    os << "revisit_max_correction_m and _deg must be >= 0; ";
   if (max_candidates < 1) os << "max_candidates must be >= 1; ";
   if (min_matches < 3 || min_ransac_inliers < 3)
     os << "min_matches and min_ransac_inliers must be >= 3; ";
@@ -36,8 +43,7 @@ bool LoopClosingOptions::Check(std::string* error) const {
 LoopCloser::LoopCloser(const PinholeCamera& camera, LoopClosingOptions options)
     : camera_(camera),
       options_(options),
-      rng_(options.seed),
-      consistency_(options.consistent_detections) {
+      rng_(options.seed) {
   std::string error;
   DETSLAM_CHECK_MSG(options_.Check(&error), "invalid LoopClosingOptions: " << error);
 }
@@ -48,25 +54,75 @@ LoopClosingResult LoopCloser::Process(Map& map, KeyFrameId kf_id) {
   if (!options_.enabled || !map.HasKeyFrame(kf_id)) return result;
   if (last_loop_kf_ != kNoKeyFrame && kf_id - last_loop_kf_ < 5) return result;
   const bool by_appearance = !map.keyframe(kf_id).features->bow.empty();
-  const std::vector<KeyFrameId> candidates =
-      by_appearance ? CandidatesByAppearance(map, kf_id) : CandidatesByPosition(map, kf_id);
-  for (const KeyFrameId candidate : candidates) {
+  if (!by_appearance) {
+    for (const KeyFrameId candidate : CandidatesByPosition(map, kf_id)) {
+      Verified loop;
+      if (!Verify(map, kf_id, candidate, &loop)) continue;
+      Close(map, kf_id, loop, &result);
+      break;
+    }
+    return result;
+  }
+  if (pending_ && ConfirmPending(map, kf_id)) {
+    if (pending_->coincidences >= options_.consistent_detections) {
+      const Verified loop = *pending_;
+      Close(map, kf_id, loop, &result);
+    }
+    return result;  // confirmed here: no new search (ORB-SLAM3 neither)
+  }
+  // New candidates by appearance; the one most keyframes agree with replaces a pending loop that
+  // fewer agree with.
+  std::optional<Verified> best;
+  for (const KeyFrameId candidate : CandidatesByAppearance(map, kf_id)) {
     Verified loop;
     if (!Verify(map, kf_id, candidate, &loop)) continue;
-    Correct(map, kf_id, loop, &result);
-    result.closed = true;
-    result.candidate = candidate;
-    result.inliers = loop.inliers;
-    last_loop_kf_ = kf_id;
-    ++loops_closed_;
-    consistency_.Reset();
-    spdlog::info(
-        "loop closed: keyframe {} with keyframe {} ({} inliers, {} landmarks fused, correction "
-        "{:.3f} m)",
-        kf_id, candidate, loop.inliers, result.fused, result.correction_m);
-    break;
+    loop.coincidences = CountCoincidences(map, loop);
+    spdlog::debug("  loop candidate {} for keyframe {}: {} keyframes agree", candidate, kf_id,
+                  loop.coincidences);
+    if (!best || loop.coincidences > best->coincidences) best = std::move(loop);
+  }
+  if (best && best->coincidences >= options_.consistent_detections) {
+    const Verified loop = std::move(*best);
+    Close(map, kf_id, loop, &result);
+  } else if (best && (!pending_ || best->coincidences > pending_->coincidences)) {
+    pending_ = std::move(best);
   }
   return result;
+}
+
+void LoopCloser::Close(Map& map, KeyFrameId kf_id, const Verified& loop,
+                       LoopClosingResult* result) {
+  last_loop_kf_ = kf_id;
+  pending_.reset();
+  result->candidate = loop.candidate;
+  result->inliers = loop.inliers;
+  result->agreeing = std::max(1, loop.coincidences);
+  // A revisit that the map already agrees with (the place seen again with no drift to speak of):
+  // the duplicated landmarks are fused, but there is nothing to correct.
+  const double moved_m = (loop.cam_from_world.Inverse().translation() -
+                          map.keyframe(kf_id).Center()).norm();
+  const double turned_deg =
+      Eigen::AngleAxisd(loop.correction.rotation()).angle() * 180.0 / M_PI;
+  if (moved_m < options_.revisit_max_correction_m &&
+      turned_deg < options_.revisit_max_correction_deg) {
+    Correct(map, kf_id, loop, /*correct_poses=*/false, result);
+    result->revisit = true;
+    ++stats_.revisits;
+    spdlog::info(
+        "place revisited: keyframe {} with keyframe {} ({} inliers, {} keyframes agree, {} "
+        "landmarks fused, {:.1f} mm / {:.2f} deg off: no correction)",
+        kf_id, loop.candidate, loop.inliers, loop.coincidences, result->fused, moved_m * 1000,
+        turned_deg);
+    return;
+  }
+  Correct(map, kf_id, loop, /*correct_poses=*/true, result);
+  result->closed = true;
+  ++loops_closed_;
+  spdlog::info(
+      "loop closed: keyframe {} with keyframe {} ({} inliers, {} keyframes agree, {} landmarks "
+      "fused, correction {:.3f} m)",
+      kf_id, loop.candidate, loop.inliers, loop.coincidences, result->fused,
+      result->correction_m);
 }
 
 bool LoopCloser::WithinRadius(const Map& map, KeyFrameId kf_id, KeyFrameId other) const {
@@ -96,7 +152,8 @@ std::vector<KeyFrameId> LoopCloser::CandidatesByPosition(const Map& map, KeyFram
   return out;
 }
 
-std::vector<KeyFrameId> LoopCloser::CandidatesByAppearance(const Map& map, KeyFrameId kf_id) {
+std::vector<KeyFrameId> LoopCloser::CandidatesByAppearance(const Map& map,
+                                                           KeyFrameId kf_id) const {
   std::set<KeyFrameId> recent;
   for (auto it = map.keyframes().rbegin(); it != map.keyframes().rend(); ++it) {
     if (it->first <= kf_id - options_.min_keyframe_gap) break;
@@ -109,22 +166,28 @@ std::vector<KeyFrameId> LoopCloser::CandidatesByAppearance(const Map& map, KeyFr
                     [&](const PlaceCandidate& c) { return !WithinRadius(map, kf_id, c.keyframe); }),
                 found.end());
   }
-  std::vector<KeyFrameId> accepted = consistency_.Update(map, found);
-  spdlog::debug("keyframe {}: {} loop candidates by appearance, {} consistent", kf_id, found.size(),
-                accepted.size());
-  if (accepted.size() > static_cast<size_t>(options_.max_candidates))
-    accepted.resize(static_cast<size_t>(options_.max_candidates));
-  return accepted;
+  std::vector<KeyFrameId> out;
+  for (const PlaceCandidate& c : found) {
+    if (out.size() >= static_cast<size_t>(options_.appearance_candidates)) break;
+    out.push_back(c.keyframe);
+  }
+  spdlog::debug("keyframe {}: {} loop candidates by appearance, {} verified", kf_id, found.size(),
+                out.size());
+  return out;
 }
 
 bool LoopCloser::Verify(const Map& map, KeyFrameId kf_id, KeyFrameId candidate_id, Verified* out) {
   const KeyFrame& kf = map.keyframe(kf_id);
   const FrameFeatures& f = *kf.features;
   const KeyFrame& candidate = map.keyframe(candidate_id);
-  const bool by_node = !f.bow_nodes.empty() && !candidate.features->bow_nodes.empty();
-  std::vector<LandmarkId> matched = MatchKeyFrameLandmarks(
-      candidate, f, 0.9, kThHigh,
-      by_node ? DescriptorSearch::kVocabularyNode : DescriptorSearch::kBruteForce);
+  // Matched against the candidate and its best covisibles (ORB-SLAM3 matches a loop candidate's
+  // window the same way): the revisit sees the old place from another viewpoint, so one old
+  // keyframe alone often shares too few matches.
+  std::vector<const KeyFrame*> window{&candidate};
+  for (KeyFrameId n : map.BestCovisibles(candidate_id, options_.candidate_window))
+    window.push_back(&map.keyframe(n));
+  std::vector<LandmarkId> matched =
+      MatchKeyFramesLandmarks(window, f, 0.9, kThHigh, options_.window_search);
   std::vector<Eigen::Vector3d> world, cam;
   std::vector<size_t> kp;
   for (size_t i = 0; i < f.size(); ++i) {
@@ -135,68 +198,148 @@ bool LoopCloser::Verify(const Map& map, KeyFrameId kf_id, KeyFrameId candidate_i
   }
   spdlog::debug("loop candidate {} for keyframe {}: {} matches with depth", candidate_id, kf_id,
                 kp.size());
+  ++stats_.candidates;
   if (static_cast<int>(kp.size()) < options_.min_matches) return false;
+  ++stats_.enough_matches;
   RansacOptions ro;
   ro.min_inliers = options_.min_ransac_inliers;
   const RigidRansacResult rr = EstimateRigidRansac(world, cam, options_.ransac_inlier_m, ro, rng_);
   spdlog::debug("  rigid RANSAC: {} inliers", rr.num_inliers);
   if (!rr.success) return false;
+  ++stats_.rigid_ransac;
 
-  // Pose-only refinement, then more matches from the candidate's neighbourhood by projection.
+  // Pose-only refinement, then more matches from the candidate's window by projection.
   std::vector<LandmarkId> assoc(f.size(), kNoLandmark);
   for (size_t k = 0; k < kp.size(); ++k) {
     if (rr.inliers[k]) assoc[kp[k]] = matched[kp[k]];
   }
-  Rigid3d pose = rr.b_from_a;
-  auto optimise = [&]() {
-    std::vector<PoseObservation> obs;
-    std::vector<size_t> idx;
-    for (size_t i = 0; i < f.size(); ++i) {
-      if (assoc[i] == kNoLandmark) continue;
-      obs.push_back(KeypointObservation(f, i, map.landmark(assoc[i]).position, map.scale()));
-      idx.push_back(i);
-    }
-    if (obs.size() < 3) return 0;
-    const PoseOptimizerResult r = OptimizePose(camera_, pose, obs, PoseOptimizerOptions());
-    pose = r.cam_from_world;
-    for (size_t k = 0; k < obs.size(); ++k) {
-      if (!r.inliers[k]) assoc[idx[k]] = kNoLandmark;
-    }
-    return r.num_inliers;
-  };
-  if (optimise() < options_.min_ransac_inliers) return false;
-  std::vector<KeyFrameId> neighbourhood = map.BestCovisibles(candidate_id, 10);
-  neighbourhood.push_back(candidate_id);
-  std::set<LandmarkId> seen(assoc.begin(), assoc.end()), loop_side;
-  std::vector<ProjectionCandidate> candidates;
-  for (KeyFrameId n : neighbourhood) {
-    for (LandmarkId lm : map.keyframe(n).landmarks) {
-      if (lm == kNoLandmark || !map.HasLandmark(lm)) continue;
-      if (loop_side.insert(lm).second) out->loop_landmarks.push_back(lm);
-      if (seen.insert(lm).second) candidates.push_back(CandidateFromLandmark(map.landmark(lm)));
+  std::set<LandmarkId> loop_side;
+  for (const KeyFrame* n : window) {
+    for (LandmarkId lm : n->landmarks) {
+      if (lm != kNoLandmark && map.HasLandmark(lm) && loop_side.insert(lm).second)
+        out->loop_landmarks.push_back(lm);
     }
   }
-  std::vector<bool> taken(f.size());
-  for (size_t i = 0; i < f.size(); ++i) taken[i] = assoc[i] != kNoLandmark;
+  out->candidate = candidate_id;
+  if (!Refine(map, kf_id, rr.b_from_a, std::move(assoc), out)) return false;
+  ++stats_.verified;
+  return true;
+}
+
+namespace {
+
+// Pose-only optimisation of `pose` on the associations of `assoc` (per keypoint of `f`); drops the
+// outliers from `assoc` and returns the inlier count.
+int OptimiseAssociations(const PinholeCamera& camera, const Map& map, const FrameFeatures& f,
+                         Rigid3d* pose, std::vector<LandmarkId>* assoc) {
+  std::vector<PoseObservation> obs;
+  std::vector<size_t> idx;
+  for (size_t i = 0; i < f.size(); ++i) {
+    if ((*assoc)[i] == kNoLandmark) continue;
+    obs.push_back(KeypointObservation(f, i, map.landmark((*assoc)[i]).position, map.scale()));
+    idx.push_back(i);
+  }
+  if (obs.size() < 3) return 0;
+  const PoseOptimizerResult r = OptimizePose(camera, *pose, obs, PoseOptimizerOptions());
+  *pose = r.cam_from_world;
+  for (size_t k = 0; k < obs.size(); ++k) {
+    if (!r.inliers[k]) (*assoc)[idx[k]] = kNoLandmark;
+  }
+  return r.num_inliers;
+}
+
+ProjectionSearchOptions LoopProjectionOptions() {
   ProjectionSearchOptions po;
   po.window = 10;
   po.ratio = 0.9;
-  const std::vector<int> m =
-      SearchByProjection(camera_, map.scale(), f, pose, candidates, taken, po);
+  return po;
+}
+
+}  // namespace
+
+bool LoopCloser::Refine(const Map& map, KeyFrameId kf_id, Rigid3d pose,
+                        std::vector<LandmarkId> assoc, Verified* out) const {
+  const FrameFeatures& f = *map.keyframe(kf_id).features;
+  const bool from_ransac = std::any_of(assoc.begin(), assoc.end(),
+                                       [](LandmarkId id) { return id != kNoLandmark; });
+  if (from_ransac &&
+      OptimiseAssociations(camera_, map, f, &pose, &assoc) < options_.min_ransac_inliers)
+    return false;
+  std::set<LandmarkId> seen(assoc.begin(), assoc.end());
+  std::vector<ProjectionCandidate> candidates;
+  for (LandmarkId lm : out->loop_landmarks) {
+    if (map.HasLandmark(lm) && seen.insert(lm).second)
+      candidates.push_back(CandidateFromLandmark(map.landmark(lm)));
+  }
+  std::vector<bool> taken(f.size());
+  for (size_t i = 0; i < f.size(); ++i) taken[i] = assoc[i] != kNoLandmark;
+  const std::vector<int> m = SearchByProjection(camera_, map.scale(), f, pose, candidates, taken,
+                                                LoopProjectionOptions());
   for (size_t c = 0; c < candidates.size(); ++c) {
     if (m[c] >= 0) assoc[static_cast<size_t>(m[c])] = candidates[c].landmark;
   }
-  const int inliers = optimise();
-  spdlog::debug("  verified: {} pose-only inliers", inliers);
+  const int inliers = OptimiseAssociations(camera_, map, f, &pose, &assoc);
+  spdlog::debug("  keyframe {} with loop candidate {}: {} pose-only inliers", kf_id,
+                out->candidate, inliers);
   if (inliers < options_.min_verified_inliers) return false;
-  out->candidate = candidate_id;
+  out->keyframe = kf_id;
   out->cam_from_world = pose;
+  out->correction = pose.Inverse() * map.keyframe(kf_id).cam_from_world;
   out->matched = std::move(assoc);
   out->inliers = inliers;
   return true;
 }
 
-void LoopCloser::Correct(Map& map, KeyFrameId kf_id, const Verified& loop,
+int LoopCloser::ProjectionMatches(const Map& map, KeyFrameId kf_id, const Rigid3d& correction,
+                                  const std::vector<LandmarkId>& landmarks) const {
+  const KeyFrame& kf = map.keyframe(kf_id);
+  std::set<LandmarkId> own(kf.landmarks.begin(), kf.landmarks.end());
+  std::vector<ProjectionCandidate> candidates;
+  for (LandmarkId lm : landmarks) {
+    if (map.HasLandmark(lm) && !own.count(lm))
+      candidates.push_back(CandidateFromLandmark(map.landmark(lm)));
+  }
+  const std::vector<bool> taken(kf.size(), false);
+  const std::vector<int> m =
+      SearchByProjection(camera_, map.scale(), *kf.features, kf.cam_from_world * correction.Inverse(),
+                         candidates, taken, LoopProjectionOptions());
+  return static_cast<int>(std::count_if(m.begin(), m.end(), [](int i) { return i >= 0; }));
+}
+
+int LoopCloser::CountCoincidences(const Map& map, const Verified& loop) const {
+  int agree = 1;  // the keyframe that verified it
+  for (KeyFrameId n : map.BestCovisibles(loop.keyframe, options_.candidate_window)) {
+    if (agree >= options_.consistent_detections) break;
+    const int matches = ProjectionMatches(map, n, loop.correction, loop.loop_landmarks);
+    spdlog::debug("    covisible keyframe {}: {} projection matches", n, matches);
+    if (matches >= options_.confirm_min_matches) ++agree;
+  }
+  return agree;
+}
+
+bool LoopCloser::ConfirmPending(const Map& map, KeyFrameId kf_id) {
+  Verified next;
+  next.candidate = pending_->candidate;
+  next.loop_landmarks = pending_->loop_landmarks;
+  const Rigid3d predicted = map.keyframe(kf_id).cam_from_world * pending_->correction.Inverse();
+  const bool agrees = Refine(map, kf_id, predicted,
+                             std::vector<LandmarkId>(map.keyframe(kf_id).size(), kNoLandmark), &next);
+  spdlog::debug("keyframe {}: pending loop with keyframe {} {}", kf_id, pending_->candidate,
+                agrees ? "confirmed" : "not confirmed");
+  if (!agrees) {
+    if (++pending_->misses >= options_.max_pending_misses) {
+      pending_.reset();
+      ++stats_.pending_dropped;
+    }
+    return false;
+  }
+  ++stats_.pending_confirmed;
+  next.coincidences = pending_->coincidences + 1;
+  pending_ = std::move(next);
+  return true;
+}
+
+void LoopCloser::Correct(Map& map, KeyFrameId kf_id, const Verified& loop, bool correct_poses,
                          LoopClosingResult* result) {
   // Poses and positions before the correction.
   std::map<KeyFrameId, Rigid3d> old_pose;
@@ -246,6 +389,7 @@ void LoopCloser::Correct(Map& map, KeyFrameId kf_id, const Verified& loop,
                                        FuseWinner::kSource);
   }
   for (KeyFrameId g : group) map.UpdateConnections(g);
+  if (!correct_poses) return;
 
   // Essential graph: spanning tree, strong covisibility, and the new loop connections.
   PoseGraphProblem problem;

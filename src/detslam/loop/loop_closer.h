@@ -9,13 +9,18 @@
 //
 // Candidates: with a vocabulary (keyframes carry bag-of-words vectors), by appearance among the
 // keyframes that are neither covisible with the new one nor among its `min_keyframe_gap` newest
-// (place_candidates.h), accepted once consistent over `consistent_detections` consecutive
-// keyframes; `candidate_radius_m` > 0 adds a position gate (candidate centre within that distance
-// of the new keyframe's). Without a vocabulary: the keyframes within `candidate_radius_m`, nearest
-// first (needs a radius > 0).
+// (place_candidates.h), the best `appearance_candidates` groups; `candidate_radius_m` > 0 adds a
+// position gate (candidate centre within that distance of the new keyframe's). A verified
+// candidate is accepted once `consistent_detections` keyframes agree with it (ORB-SLAM3's
+// covisibility/temporal check): the keyframe itself, its best covisibles into which the loop
+// side's landmarks project with at least `confirm_min_matches` matches at the corrected pose, and
+// the next keyframes, verified again from the predicted correction; a pending loop is dropped after
+// `max_pending_misses` next keyframes in a row that do not confirm it. Without a vocabulary: the keyframes within
+// `candidate_radius_m`, nearest first (needs a radius > 0), accepted on verification alone.
 #pragma once
 
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -23,6 +28,7 @@
 #include "detslam/core/rng.h"
 #include "detslam/map/map.h"
 #include "detslam/map/place_candidates.h"
+#include "detslam/map/projection_search.h"
 
 namespace detslam {
 
@@ -30,8 +36,17 @@ struct LoopClosingOptions {
   bool enabled = true;
   int min_keyframe_gap = 20;        // candidates at least this many keyframe ids older
   double candidate_radius_m = 0.0;  // > 0: candidate keyframe centres within this distance
-  int consistent_detections = 3;    // consecutive keyframes a candidate group must persist
-  int max_candidates = 8;           // examined per keyframe (nearest first)
+  int consistent_detections = 3;    // keyframes that must agree on a loop found by appearance
+  int appearance_candidates = 3;    // bag-of-words groups verified per keyframe (best first)
+  int max_candidates = 8;           // by position: examined per keyframe (nearest first)
+  int confirm_min_matches = 30;     // projection matches for a covisible keyframe to agree
+  int max_pending_misses = 2;       // next keyframes in a row that fail before a pending loop goes
+  // A verified loop that would move its keyframe less than both of these is a revisit: landmarks
+  // fused, no pose correction, not counted as a loop closed.
+  double revisit_max_correction_m = 0.01;
+  double revisit_max_correction_deg = 1.0;
+  int candidate_window = 10;  // best covisibles of a candidate matched along with it
+  DescriptorSearch window_search = DescriptorSearch::kBruteForce;
   int min_matches = 40;             // descriptor matches with depth to try RANSAC
   double ransac_inlier_m = 0.05;    // 3-D inlier distance (scaled by depth / 2 m, at least this)
   int min_ransac_inliers = 30;
@@ -45,13 +60,27 @@ struct LoopClosingOptions {
 
 struct LoopClosingResult {
   bool closed = false;
+  bool revisit = false;  // verified, but the map already agreed: landmarks fused, nothing moved
   KeyFrameId keyframe = kNoKeyFrame;   // the keyframe that closed the loop
   KeyFrameId candidate = kNoKeyFrame;  // the older keyframe of the same place
   int inliers = 0;                     // verified pose-only inliers
+  int agreeing = 0;  // keyframes that agreed on it (appearance; 1 for a loop found by position)
   int fused = 0;                       // landmarks merged
   double correction_m = 0;             // how far the keyframe moved
   // Keyframe poses before the correction (cam_from_world), for the tracker and the trajectory.
   std::map<KeyFrameId, Rigid3d> old_poses;
+};
+
+// How far loop candidates got (counted over a run): the stage that rejected them shows whether a
+// look-alike place was turned down by the geometry or never proposed.
+struct LoopDetectionStats {
+  int candidates = 0;       // candidates examined (after appearance or position selection)
+  int enough_matches = 0;   // with at least min_matches descriptor matches with depth
+  int rigid_ransac = 0;     // passed 3-D rigid RANSAC (min_ransac_inliers)
+  int verified = 0;         // passed pose-only verification (min_verified_inliers)
+  int pending_confirmed = 0;  // next keyframes that confirmed a pending loop
+  int pending_dropped = 0;    // pending loops given up
+  int revisits = 0;  // verified and agreed on, but within revisit_max_correction: not corrected
 };
 
 class LoopCloser {
@@ -63,28 +92,53 @@ class LoopCloser {
   LoopClosingResult Process(Map& map, KeyFrameId kf);
 
   int loops_closed() const { return loops_closed_; }
+  const LoopDetectionStats& stats() const { return stats_; }
 
  private:
   struct Verified {
     KeyFrameId candidate = kNoKeyFrame;
-    Rigid3d cam_from_world;           // corrected pose of the current keyframe
+    KeyFrameId keyframe = kNoKeyFrame;
+    Rigid3d cam_from_world;           // corrected pose of the keyframe
+    Rigid3d correction;               // world_new_from_world_old that the loop implies
     std::vector<LandmarkId> matched;  // per keypoint of the current keyframe
     // Landmarks of the candidate's neighbourhood, to fuse into the current keyframe's.
     std::vector<LandmarkId> loop_landmarks;
     int inliers = 0;
+    int coincidences = 0;  // keyframes that agree (appearance only)
+    int misses = 0;        // next keyframes in a row that did not
   };
   bool WithinRadius(const Map& map, KeyFrameId kf, KeyFrameId other) const;
   std::vector<KeyFrameId> CandidatesByPosition(const Map& map, KeyFrameId kf) const;
-  std::vector<KeyFrameId> CandidatesByAppearance(const Map& map, KeyFrameId kf);
+  std::vector<KeyFrameId> CandidatesByAppearance(const Map& map, KeyFrameId kf) const;
+  // Descriptor matching against the candidate's window, rigid RANSAC, then Refine.
   bool Verify(const Map& map, KeyFrameId kf, KeyFrameId candidate, Verified* out);
-  void Correct(Map& map, KeyFrameId kf, const Verified& loop, LoopClosingResult* result);
+  // From `pose` and the associations in `assoc` (per keypoint of kf), more matches by projecting
+  // out->loop_landmarks, pose-only optimisation; fills `out` when enough inliers remain.
+  bool Refine(const Map& map, KeyFrameId kf, Rigid3d pose, std::vector<LandmarkId> assoc,
+              Verified* out) const;
+  // Number of loop-side landmarks matched by projection into keyframe `kf` at its pose moved by
+  // `correction`.
+  int ProjectionMatches(const Map& map, KeyFrameId kf, const Rigid3d& correction,
+                        const std::vector<LandmarkId>& landmarks) const;
+  // Appearance: keyframes agreeing with a loop just verified at `loop.keyframe` (it and its best
+  // covisibles), up to consistent_detections.
+  int CountCoincidences(const Map& map, const Verified& loop) const;
+  // Appearance: a pending loop checked against the new keyframe `kf`; true if it agrees (then the
+  // pending loop is re-verified at kf).
+  bool ConfirmPending(const Map& map, KeyFrameId kf);
+  void Close(Map& map, KeyFrameId kf, const Verified& loop, LoopClosingResult* result);
+  // Fuses the loop side's landmarks into kf's neighbourhood and, with correct_poses, moves the map
+  // (pose graph, landmarks with their reference keyframes).
+  void Correct(Map& map, KeyFrameId kf, const Verified& loop, bool correct_poses,
+               LoopClosingResult* result);
 
   PinholeCamera camera_;
   LoopClosingOptions options_;
   Rng rng_;
-  LoopConsistency consistency_;
+  std::optional<Verified> pending_;  // appearance: verified but not yet agreed on
   KeyFrameId last_loop_kf_ = kNoKeyFrame;
   int loops_closed_ = 0;
+  LoopDetectionStats stats_;
 };
 
 }  // namespace detslam

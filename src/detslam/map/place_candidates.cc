@@ -10,15 +10,6 @@ namespace {
 // shared map points).
 constexpr int kConnectedMinWeight = 15;
 
-std::set<KeyFrameId> ConnectedGroup(const Map& map, KeyFrameId kf) {
-  std::set<KeyFrameId> group;
-  group.insert(kf);
-  for (const auto& [other, weight] : map.keyframe(kf).covisibility) {
-    if (weight >= kConnectedMinWeight) group.insert(other);
-  }
-  return group;
-}
-
 }  // namespace
 
 std::vector<PlaceCandidate> QueryPlaceCandidates(const Map& map, const BowVector& bow,
@@ -93,45 +84,6 @@ std::vector<PlaceCandidate> LoopCandidates(const Map& map, KeyFrameId kf,
   }
   options.min_score = any_neighbour ? min_score : 0.0;
   return QueryPlaceCandidates(map, bow, options);
-}
-
-std::vector<KeyFrameId> LoopConsistency::Update(const Map& map,
-                                                const std::vector<PlaceCandidate>& candidates) {
-  std::vector<KeyFrameId> accepted;
-  if (candidates.empty()) {
-    groups_.clear();
-    return accepted;
-  }
-  std::vector<Group> current;
-  std::vector<bool> continued(groups_.size(), false);
-  for (const PlaceCandidate& c : candidates) {
-    if (!map.HasKeyFrame(c.keyframe)) continue;
-    const std::set<KeyFrameId> members = ConnectedGroup(map, c.keyframe);
-    bool continues_some = false;
-    bool accepted_here = false;
-    for (size_t g = 0; g < groups_.size(); ++g) {
-      const std::set<KeyFrameId>& previous = groups_[g].members;
-      const bool shares = std::any_of(members.begin(), members.end(),
-                                      [&](KeyFrameId id) { return previous.count(id) > 0; });
-      if (!shares) continue;
-      continues_some = true;
-      const int detections = groups_[g].detections + 1;
-      if (!continued[g]) {
-        current.push_back({members, detections});
-        continued[g] = true;
-      }
-      if (detections >= required_ && !accepted_here) {
-        accepted.push_back(c.keyframe);
-        accepted_here = true;
-      }
-    }
-    if (!continues_some) {
-      current.push_back({members, 1});
-      if (required_ <= 1) accepted.push_back(c.keyframe);
-    }
-  }
-  groups_ = std::move(current);
-  return accepted;
 }
 
 }  // namespace detslam

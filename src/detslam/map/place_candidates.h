@@ -43,28 +43,4 @@ std::vector<PlaceCandidate> RelocalizationCandidates(const Map& map, const BowVe
 std::vector<PlaceCandidate> LoopCandidates(const Map& map, KeyFrameId kf,
                                            const std::set<KeyFrameId>& exclude = {});
 
-// Loop consistency over consecutive keyframes (after ORB-SLAM2's): a candidate's group (itself
-// and its connected keyframes) continues a group of the previous keyframe's candidates when they
-// share a keyframe; a candidate is accepted once its group has been detected in `required`
-// consecutive keyframes. (ORB-SLAM2 counts continuations and accepts at 3, i.e. on the 4th
-// consecutive detection; our default of 3 detections accepts one keyframe earlier.)
-class LoopConsistency {
- public:
-  explicit LoopConsistency(int required = 3) : required_(required) {}
-
-  // Updates the consistent groups with this keyframe's candidates and returns those accepted (in
-  // candidate order).
-  std::vector<KeyFrameId> Update(const Map& map, const std::vector<PlaceCandidate>& candidates);
-  // Forgets every group (after a loop was closed, or a keyframe without candidates).
-  void Reset() { groups_.clear(); }
-
- private:
-  struct Group {
-    std::set<KeyFrameId> members;
-    int detections = 1;  // consecutive keyframes this group was detected in
-  };
-  int required_;
-  std::vector<Group> groups_;
-};
-
 }  // namespace detslam

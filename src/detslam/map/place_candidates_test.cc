@@ -67,30 +67,5 @@ TEST(PlaceCandidates, LoopCandidatesSkipNeighboursAndScoreBelowThem) {
   EXPECT_TRUE(LoopCandidates(map, current, {old_place}).empty());
 }
 
-TEST(LoopConsistency, AcceptsAGroupDetectedInThreeConsecutiveKeyFrames) {
-  Map map(ScaleInfo::Geometric(1.2, 8));
-  std::vector<KeyFrameId> kf;
-  for (int i = 0; i < 6; ++i) kf.push_back(AddWithWords(&map, {{i, 1.0}}));
-  Connect(&map, kf[0], kf[1], 30);
-  Connect(&map, kf[1], kf[2], 30);
-  Connect(&map, kf[4], kf[5], 30);
-  LoopConsistency consistency(3);
-  auto cand = [](KeyFrameId id) { return std::vector<PlaceCandidate>{{id, 0.1, 0.1}}; };
-  EXPECT_TRUE(consistency.Update(map, cand(kf[0])).empty());  // detected once
-  EXPECT_TRUE(consistency.Update(map, cand(kf[1])).empty());  // twice: shares kf[0], kf[1]
-  EXPECT_EQ(consistency.Update(map, cand(kf[2])), std::vector<KeyFrameId>{kf[2]});
-  // An unrelated group starts over; a keyframe without candidates breaks the chain.
-  EXPECT_TRUE(consistency.Update(map, cand(kf[4])).empty());
-  EXPECT_TRUE(consistency.Update(map, {}).empty());
-  EXPECT_TRUE(consistency.Update(map, cand(kf[5])).empty());
-  EXPECT_TRUE(consistency.Update(map, cand(kf[4])).empty());
-  // A weak covisibility link (< 15 shared points) does not make groups consistent.
-  Connect(&map, kf[3], kf[4], 5);
-  LoopConsistency fresh(2);
-  EXPECT_TRUE(fresh.Update(map, cand(kf[3])).empty());
-  EXPECT_TRUE(fresh.Update(map, cand(kf[4])).empty());
-  EXPECT_EQ(fresh.Update(map, cand(kf[5])), std::vector<KeyFrameId>{kf[5]});
-}
-
 }  // namespace
 }  // namespace detslam

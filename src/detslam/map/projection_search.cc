@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <limits>
+#include <unordered_set>
 
 #include "detslam/features/matcher.h"
 #include "detslam/features/orb_extractor.h"
@@ -44,6 +45,21 @@ std::vector<LandmarkId> MatchKeyFrameLandmarks(const KeyFrame& keyframe, const F
   for (const cv::DMatch& m : MatchWithinGroups(kf.keypoints, kf.descriptors, frame.keypoints,
                                                frame.descriptors, groups, mo)) {
     out[static_cast<size_t>(m.trainIdx)] = keyframe.landmarks[static_cast<size_t>(m.queryIdx)];
+  }
+  return out;
+}
+
+std::vector<LandmarkId> MatchKeyFramesLandmarks(const std::vector<const KeyFrame*>& keyframes,
+                                                const FrameFeatures& frame, double ratio,
+                                                int max_distance, DescriptorSearch search) {
+  std::vector<LandmarkId> out(frame.size(), kNoLandmark);
+  std::unordered_set<LandmarkId> used;
+  for (const KeyFrame* keyframe : keyframes) {
+    const std::vector<LandmarkId> m =
+        MatchKeyFrameLandmarks(*keyframe, frame, ratio, max_distance, search);
+    for (size_t i = 0; i < m.size(); ++i) {
+      if (out[i] == kNoLandmark && m[i] != kNoLandmark && used.insert(m[i]).second) out[i] = m[i];
+    }
   }
   return out;
 }

@@ -50,6 +50,13 @@ std::vector<LandmarkId> MatchKeyFrameLandmarks(
     const KeyFrame& keyframe, const FrameFeatures& frame, double ratio, int max_distance,
     DescriptorSearch search = DescriptorSearch::kBruteForce);
 
+// MatchKeyFrameLandmarks against several keyframes in turn (e.g. a place candidate and its best
+// covisibles, as ORB-SLAM3 matches a loop candidate's window): a frame keypoint keeps the first
+// landmark it matched, and a landmark is matched to at most one keypoint.
+std::vector<LandmarkId> MatchKeyFramesLandmarks(
+    const std::vector<const KeyFrame*>& keyframes, const FrameFeatures& frame, double ratio,
+    int max_distance, DescriptorSearch search = DescriptorSearch::kBruteForce);
+
 // For each candidate, the index of the matched keypoint in `features` (or -1). Keypoints listed in
 // `taken` (same size as features; true = already associated) are skipped. Deterministic.
 std::vector<int> SearchByProjection(const PinholeCamera& camera, const ScaleInfo& scale,

@@ -74,9 +74,18 @@ void WriteOutputs(const RgbdDataset& dataset, const Settings& settings, const Ru
                      {"candidate_keyframe", r.loop_candidate},
                      {"candidate_frame", r.loop_candidate_frame},
                      {"inliers", r.loop_inliers},
+                     {"agreeing_keyframes", r.loop_agreeing},
                      {"correction_m", r.loop_correction_m}});
   }
   j["loops"] = loops;
+  const LoopDetectionStats& ld = summary.loop_detection;
+  j["loop_detection"] = {{"candidates", ld.candidates},
+                         {"enough_matches", ld.enough_matches},
+                         {"rigid_ransac", ld.rigid_ransac},
+                         {"verified", ld.verified},
+                         {"pending_confirmed", ld.pending_confirmed},
+                         {"pending_dropped", ld.pending_dropped},
+                         {"revisits", ld.revisits}};
   j["vocabulary"] = slam.vocabulary_path();
   j["wall_s"] = summary.wall_s;
   j["segmenter"] = summary.segmenter.empty() ? "none" : summary.segmenter;
@@ -160,6 +169,7 @@ class RunRecorder {
     if (segmenter != nullptr) summary_.segmenter = segmenter->name();
     summary_.segmentation = ComputeErrorStats(seg_);
     summary_.loops = static_cast<size_t>(slam.loops_closed());
+    summary_.loop_detection = slam.loop_detection_stats();
     {
       const MapStore::ReadAccess map = slam.ReadMap();
       summary_.keyframes = map->NumKeyFrames();

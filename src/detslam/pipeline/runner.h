@@ -35,6 +35,7 @@ struct RunSummary {
   size_t landmarks = 0;
   size_t relocalizations = 0;
   size_t loops = 0;  // loops closed
+  LoopDetectionStats loop_detection;
   double wall_s = 0;
   ErrorStats segmentation, extraction, tracking, mapping, total;  // per-stage times, ms
   std::string segmenter;  // backend name, empty without segmentation

@@ -102,6 +102,7 @@ std::vector<Binding> MakeBindings() {
   k.push_back(Key("LocalMapping.Triangulate", "triangulate keypoints without close depth with covisible keyframes", [](auto& r) -> auto& { return r.run.slam.mapper.triangulate; }));
   k.push_back(Key("LoopClosing.Enabled", "loop detection and correction", [](auto& r) -> auto& { return r.run.slam.loop.enabled; }));
   k.push_back(Key("LoopClosing.CandidateRadius", 0, kInf, "loop candidates: keyframe centres within this distance (m); 0: no position gate (needs a vocabulary)", [](auto& r) -> auto& { return r.run.slam.loop.candidate_radius_m; }));
+  k.push_back(Key("LoopClosing.ConsistentDetections", 1, kInf, "loops found by appearance: keyframes that must agree (the verifying one, its covisibles, the next ones)", [](auto& r) -> auto& { return r.run.slam.loop.consistent_detections; }));
   k.push_back(Key("Place.Vocabulary", "bag-of-words vocabulary file for relocalisation and loop detection (empty: the shipped one; none: no place recognition) (--vocabulary)", [](auto& r) -> auto& { return r.run.slam.vocabulary; }));
   k.push_back(Key("LoopClosing.GlobalBAIterations", 0, kInf, "global bundle adjustment iterations after a loop (0: none)", [](auto& r) -> auto& { return r.run.slam.loop.global_ba_iterations; }));
   // Det-SLAM dynamic filter.

@@ -69,6 +69,7 @@ void SlamSystem::MapKeyFrame(KeyFrameId kf, FrameReport* report) {
       report->loop_candidate = loop.candidate;
       report->loop_candidate_frame = map->keyframe(loop.candidate).frame_index;
       report->loop_inliers = loop.inliers;
+      report->loop_agreeing = loop.agreeing;
       report->loop_correction_m = loop.correction_m;
       global_ba = options_.loop.global_ba_iterations > 0;
     }
@@ -92,6 +93,11 @@ std::vector<double> SlamSystem::mapping_times_ms() const {
 int SlamSystem::loops_closed() const {
   const MapStore::ReadAccess map = store_.Read();
   return loop_closer_.loops_closed();
+}
+
+LoopDetectionStats SlamSystem::loop_detection_stats() const {
+  const MapStore::ReadAccess map = store_.Read();
+  return loop_closer_.stats();
 }
 
 FrameReport SlamSystem::ProcessFrame(int64_t index, Timestamp stamp, const cv::Mat& gray,

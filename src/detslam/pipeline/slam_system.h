@@ -52,6 +52,7 @@ struct FrameReport {
   KeyFrameId loop_candidate = kNoKeyFrame;  //   the older keyframe of the same place
   int64_t loop_candidate_frame = -1;        //   and the input frame it was made from
   int loop_inliers = 0;                     //   verified inliers
+  int loop_agreeing = 0;                    //   keyframes that agreed on it
   double loop_correction_m = 0;             //   how far the pose graph moved the keyframe
   int num_keypoints = 0;
   FrameTimings timings;
@@ -105,6 +106,7 @@ class SlamSystem {
   std::vector<double> mapping_times_ms() const;
   // Loops closed so far.
   int loops_closed() const;
+  LoopDetectionStats loop_detection_stats() const;
   // The vocabulary file in use ("none" without place recognition).
   const std::string& vocabulary_path() const { return vocabulary_path_; }
 

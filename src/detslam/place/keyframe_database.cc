@@ -14,6 +14,7 @@ int32_t KeyFrameDatabase::SlotOf(Id id) {
   } else {
     slot = static_cast<int32_t>(id_of_slot_.size());
     id_of_slot_.push_back(id);
+    bow_of_slot_.emplace_back();
   }
   slot_of_[id] = slot;
   return slot;
@@ -21,29 +22,31 @@ int32_t KeyFrameDatabase::SlotOf(Id id) {
 
 void KeyFrameDatabase::Insert(Id id, const BowVector& bow) {
   Erase(id);
-  bows_[id] = bow;
   const int32_t slot = SlotOf(id);
+  FlatBow& flat = bow_of_slot_[static_cast<size_t>(slot)];
+  flat.clear();
   const double norm = L1Norm(bow);
   if (norm <= 0.0) return;
   for (const auto& [word, weight] : bow) {
     if (weight == 0.0 || word < 0) continue;
     if (static_cast<size_t>(word) >= index_.size()) index_.resize(static_cast<size_t>(word) + 1);
-    index_[static_cast<size_t>(word)].push_back({slot, std::abs(weight) / norm});
+    index_[static_cast<size_t>(word)].push_back(slot);
+    flat.emplace_back(word, std::abs(weight) / norm);
   }
 }
 
 void KeyFrameDatabase::Erase(Id id) {
-  auto it = bows_.find(id);
-  if (it == bows_.end()) return;
-  const int32_t slot = slot_of_.at(id);
-  for (const auto& entry : it->second) {
-    if (entry.first < 0 || static_cast<size_t>(entry.first) >= index_.size()) continue;
+  auto it = slot_of_.find(id);
+  if (it == slot_of_.end()) return;
+  const int32_t slot = it->second;
+  FlatBow& flat = bow_of_slot_[static_cast<size_t>(slot)];
+  for (const auto& entry : flat) {
     auto& v = index_[static_cast<size_t>(entry.first)];
-    v.erase(std::remove_if(v.begin(), v.end(), [slot](const Posting& p) { return p.slot == slot; }),
-            v.end());
+    v.erase(std::remove(v.begin(), v.end(), slot), v.end());
   }
-  bows_.erase(it);
-  slot_of_.erase(id);
+  flat.clear();
+  flat.shrink_to_fit();
+  slot_of_.erase(it);
   id_of_slot_[static_cast<size_t>(slot)] = -1;
   free_slots_.push_back(slot);
 }
@@ -58,20 +61,16 @@ std::vector<KeyFrameDatabase::Result> KeyFrameDatabase::Query(const BowVector& b
 std::vector<KeyFrameDatabase::Result> KeyFrameDatabase::Query(const BowVector& bow,
                                                               const QueryOptions& options) const {
   // For L1-normalised non-negative vectors, 1 - 0.5 * |a - b|_1 = sum over common words of
-  // min(a_w, b_w): only the shared words' index entries are needed.
+  // min(a_w, b_w): only the shared words matter.
   std::vector<Result> results;
   const double norm = L1Norm(bow);
   if (norm <= 0.0) return results;
-  // Accumulate over the postings of the query's words into dense per-slot sums.
-  std::vector<double> score(id_of_slot_.size(), 0.0);
+  // Pass 1: shared words per slot, over the postings of the query's words.
   std::vector<int> common(id_of_slot_.size(), 0);
   for (const auto& [word, weight] : bow) {
+    (void)weight;
     if (word < 0 || static_cast<size_t>(word) >= index_.size()) continue;
-    const double q = std::abs(weight) / norm;
-    for (const Posting& p : index_[static_cast<size_t>(word)]) {
-      score[static_cast<size_t>(p.slot)] += std::min(q, p.weight);
-      ++common[static_cast<size_t>(p.slot)];
-    }
+    for (const int32_t slot : index_[static_cast<size_t>(word)]) ++common[static_cast<size_t>(slot)];
   }
   int max_common = 0;
   for (size_t s = 0; s < common.size(); ++s) {
@@ -81,11 +80,34 @@ std::vector<KeyFrameDatabase::Result> KeyFrameDatabase::Query(const BowVector& b
     }
     max_common = std::max(max_common, common[s]);
   }
+  // Pass 2: the score of each slot that passes the filter, merging its vector with the query's
+  // (both by ascending word; the same sum, in the same order, as accumulating over postings).
+  std::vector<std::pair<int, double>> query;
+  query.reserve(bow.size());
+  for (const auto& [word, weight] : bow) {
+    if (word >= 0 && static_cast<size_t>(word) < index_.size())
+      query.emplace_back(word, std::abs(weight) / norm);
+  }
   const double min_common = options.min_common_ratio * max_common;
   for (size_t s = 0; s < common.size(); ++s) {
     if (common[s] == 0) continue;
     if (options.min_common_ratio > 0.0 && !(common[s] > min_common)) continue;
-    const double clipped = std::min(score[s], 1.0);
+    double score = 0.0;
+    const FlatBow& kf = bow_of_slot_[s];
+    auto q = query.begin();
+    auto k = kf.begin();
+    while (q != query.end() && k != kf.end()) {
+      if (q->first < k->first) {
+        ++q;
+      } else if (k->first < q->first) {
+        ++k;
+      } else {
+        score += std::min(q->second, k->second);
+        ++q;
+        ++k;
+      }
+    }
+    const double clipped = std::min(score, 1.0);
     if (clipped > 0.0 && clipped >= options.min_score) {
       results.push_back({id_of_slot_[s], clipped, common[s]});
     }
@@ -102,8 +124,8 @@ std::vector<KeyFrameDatabase::Result> KeyFrameDatabase::Query(const BowVector& b
 std::vector<KeyFrameDatabase::Id> KeyFrameDatabase::KeyFramesWithWord(int word) const {
   std::vector<Id> ids;
   if (word < 0 || static_cast<size_t>(word) >= index_.size()) return ids;
-  for (const Posting& p : index_[static_cast<size_t>(word)]) {
-    ids.push_back(id_of_slot_[static_cast<size_t>(p.slot)]);
+  for (const int32_t slot : index_[static_cast<size_t>(word)]) {
+    ids.push_back(id_of_slot_[static_cast<size_t>(slot)]);
   }
   return ids;
 }

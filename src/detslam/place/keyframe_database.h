@@ -1,7 +1,8 @@
-// Inverted index over keyframes' bag-of-words vectors: word -> (keyframe, weight), so that a
-// query scores only the keyframes that share at least one word with it. A query walks the lists
-// of its words once, accumulating into dense per-keyframe slots (no per-keyframe allocation), so
-// its cost is the number of postings it visits.
+// Inverted index over keyframes' bag-of-words vectors: word -> keyframes, so that a query scores
+// only the keyframes that share at least one word with it. A query walks the lists of its words
+// once, counting shared words into dense per-keyframe slots (4 bytes per posting visited), then
+// scores only the keyframes that pass the shared-words filter, each by merging its stored
+// (normalised, flat) vector with the query's. With ORB-SLAM's 0.8 filter few keyframes are scored.
 #pragma once
 
 #include <cstddef>
@@ -42,28 +43,25 @@ class KeyFrameDatabase {
   // Removes keyframe `id`; unknown ids are ignored.
   void Erase(Id id);
   // The at most `max_results` keyframes sharing a word with `bow`, best score first (ties: lower id
-  // first), each with its ScoreL1 against `bow`; keyframes scoring 0 are left out.
+  // first), each with its ScoreL1 against `bow`; keyframes scoring 0 are left out. (Scores every
+  // keyframe sharing a word: on a large map prefer the options with min_common_ratio.)
   std::vector<Result> Query(const BowVector& bow, int max_results) const;
   // The same with the filters of `options`.
   std::vector<Result> Query(const BowVector& bow, const QueryOptions& options) const;
 
-  size_t size() const { return bows_.size(); }
-  bool Contains(Id id) const { return bows_.count(id) > 0; }
+  size_t size() const { return slot_of_.size(); }
+  bool Contains(Id id) const { return slot_of_.count(id) > 0; }
   // Keyframes listed under `word` (in insertion order), for tests and diagnostics.
   std::vector<Id> KeyFramesWithWord(int word) const;
 
  private:
-  // One posting of an inverted list: the keyframe's dense slot and its normalised word weight.
-  struct Posting {
-    int32_t slot;
-    double weight;
-  };
+  // A keyframe's vector as stored: (word, |w| / |bow|_1) by ascending word, zero weights left out.
+  using FlatBow = std::vector<std::pair<int, double>>;
   int32_t SlotOf(Id id);  // assigns a slot to a new keyframe (reusing freed ones, newest first)
-
-  std::map<Id, BowVector> bows_;             // every keyframe's vector
-  std::vector<std::vector<Posting>> index_;  // word -> postings, in insertion order
+  std::vector<std::vector<int32_t>> index_;  // word -> slots of the keyframes with it, in insertion order
   std::unordered_map<Id, int32_t> slot_of_;  // keyframe -> dense slot (accumulator index)
   std::vector<Id> id_of_slot_;               // slot -> keyframe (-1: free)
+  std::vector<FlatBow> bow_of_slot_;         // slot -> its keyframe's vector
   std::vector<int32_t> free_slots_;
 };
 
