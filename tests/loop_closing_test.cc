@@ -23,9 +23,11 @@ struct LoopRun {
   double ate_m = 0;
 };
 
-LoopRun RunLoopPreset(const SyntheticSequence& seq, bool loop_closing) {
+LoopRun RunLoopPreset(const SyntheticSequence& seq, bool loop_closing,
+                      bool global_ba_thread = false) {
   SlamOptions options;
   options.loop.enabled = loop_closing;
+  options.global_ba_thread = global_ba_thread;
   SlamSystem slam(seq.camera(), options);
   Trajectory gt;
   LoopRun run;
@@ -42,7 +44,9 @@ LoopRun RunLoopPreset(const SyntheticSequence& seq, bool loop_closing) {
     ++run.frames;
     gt.push_back({f.stamp, f.world_from_cam});
   }
+  slam.WaitForGlobalBundleAdjustment();
   run.loops = slam.loops_closed();
+  EXPECT_EQ(slam.loops().size(), static_cast<size_t>(run.loops));
   run.ate_m = ComputeAte(gt, slam.FrameTrajectory(), AteOptions()).error_m.rmse;
   return run;
 }
@@ -64,6 +68,12 @@ TEST(IntegrationLoopClosing, ClosesTheLoopOfTheLoopPreset) {
   EXPECT_EQ(SlamOptions().loop.consistent_detections, 3);
   EXPECT_EQ(with.tracked, with.frames);
   EXPECT_LT(with.ate_m, 0.6 * without.ate_m) << "ATE with loop closing " << with.ate_m << " m, without " << without.ate_m << " m";
+  // The global bundle adjustment in a thread of its own (as with a mapping thread): frames go on
+  // while it runs, its result is merged; the loop must be as well corrected.
+  const LoopRun threaded = RunLoopPreset(seq, true, true);
+  EXPECT_GE(threaded.loops, 1);
+  EXPECT_EQ(threaded.tracked, threaded.frames);
+  EXPECT_LT(threaded.ate_m, 0.6 * without.ate_m) << "ATE with the global BA thread " << threaded.ate_m << " m";
 }
 
 }  // namespace

@@ -105,7 +105,8 @@ void PropagateBundleCorrection(const MapBundle& bundle, const std::map<KeyFrameI
 }
 
 BundleSummary GlobalBundleAdjustment(const PinholeCamera& camera, int iterations, MapStore* store,
-                                     const MapUpdatedFn& applied) {
+                                     const MapUpdatedFn& applied,
+                                     const std::function<bool(const Map&)>& still_valid) {
   BundleSummary summary;
   auto snapshot = [](const Map& map) -> std::optional<MapBundle> {
     std::vector<KeyFrameId> all;
@@ -125,6 +126,10 @@ BundleSummary GlobalBundleAdjustment(const PinholeCamera& camera, int iterations
   };
   auto apply = [&](Map& map, const MapBundle& b, bool usable) {
     if (!usable) return;
+    if (still_valid && !still_valid(map)) {
+      summary.usable = false;
+      return;
+    }
     std::map<KeyFrameId, Rigid3d> before;
     for (const auto& [id, kf] : map.keyframes()) before[id] = kf.cam_from_world;
     ApplyMapBundle(b, summary, &map);

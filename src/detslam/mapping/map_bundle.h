@@ -43,10 +43,13 @@ void PropagateBundleCorrection(const MapBundle& bundle, const std::map<KeyFrameI
 // goes on meanwhile; keyframes created meanwhile follow their spanning-tree parent's correction
 // (ORB-SLAM's propagation after its global BA thread) and landmarks created meanwhile their
 // reference keyframe's. `applied` (may be empty) runs under the same lock right after the update,
-// with every keyframe's pose before it (e.g. to move the tracker's last frame). Returns the solver
-// summary (not usable: nothing changed).
+// with every keyframe's pose before it (e.g. to move the tracker's last frame). `still_valid` (may
+// be empty), checked under the lock before the update, can discard a solution that the map has
+// outgrown (e.g. a newer loop correction). Returns the solver summary (not usable, or discarded:
+// nothing changed).
 using MapUpdatedFn = std::function<void(Map&, const std::map<KeyFrameId, Rigid3d>& old_poses)>;
 BundleSummary GlobalBundleAdjustment(const PinholeCamera& camera, int iterations, MapStore* store,
-                                     const MapUpdatedFn& applied = nullptr);
+                                     const MapUpdatedFn& applied = nullptr,
+                                     const std::function<bool(const Map&)>& still_valid = nullptr);
 
 }  // namespace detslam

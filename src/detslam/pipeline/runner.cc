@@ -67,15 +67,14 @@ void WriteOutputs(const RgbdDataset& dataset, const Settings& settings, const Ru
   j["relocalizations"] = summary.relocalizations;
   j["loops_closed"] = summary.loops;
   nlohmann::json loops = nlohmann::json::array();
-  for (const FrameReport& r : summary.reports) {
-    if (!r.loop_closed) continue;
-    loops.push_back({{"frame", r.index},
-                     {"keyframe", r.loop_keyframe},
-                     {"candidate_keyframe", r.loop_candidate},
-                     {"candidate_frame", r.loop_candidate_frame},
-                     {"inliers", r.loop_inliers},
-                     {"agreeing_keyframes", r.loop_agreeing},
-                     {"correction_m", r.loop_correction_m}});
+  for (const LoopRecord& r : summary.loop_records) {  // also those of a mapping thread
+    loops.push_back({{"frame", r.frame},
+                     {"keyframe", r.keyframe},
+                     {"candidate_keyframe", r.candidate},
+                     {"candidate_frame", r.candidate_frame},
+                     {"inliers", r.inliers},
+                     {"agreeing_keyframes", r.agreeing},
+                     {"correction_m", r.correction_m}});
   }
   j["loops"] = loops;
   const LoopDetectionStats& ld = summary.loop_detection;
@@ -168,7 +167,9 @@ class RunRecorder {
                     const Segmenter* segmenter) {
     if (segmenter != nullptr) summary_.segmenter = segmenter->name();
     summary_.segmentation = ComputeErrorStats(seg_);
+    slam.WaitForGlobalBundleAdjustment();
     summary_.loops = static_cast<size_t>(slam.loops_closed());
+    summary_.loop_records = slam.loops();
     summary_.loop_detection = slam.loop_detection_stats();
     {
       const MapStore::ReadAccess map = slam.ReadMap();
@@ -259,7 +260,9 @@ RunSummary RunThreaded(const RgbdDataset& dataset, const Settings& settings,
                        const RunOptions& options, const ProgressFn& progress,
                        Segmenter* segmenter) {
   const auto start = std::chrono::steady_clock::now();
-  SlamSystem slam(settings.camera, options.slam, segmenter);
+  SlamOptions slam_options = options.slam;
+  slam_options.global_ba_thread = options.mapping_thread;  // nothing waits for it then
+  SlamSystem slam(settings.camera, slam_options, segmenter);
   const size_t n = FrameCount(dataset, options);
   RunRecorder recorder(n, progress);
   struct Extracted {

@@ -36,6 +36,7 @@ struct RunSummary {
   size_t relocalizations = 0;
   size_t loops = 0;  // loops closed
   LoopDetectionStats loop_detection;
+  std::vector<LoopRecord> loop_records;
   double wall_s = 0;
   ErrorStats segmentation, extraction, tracking, mapping, total;  // per-stage times, ms
   std::string segmenter;  // backend name, empty without segmentation

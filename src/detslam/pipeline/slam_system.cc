@@ -51,6 +51,17 @@ SlamSystem::SlamSystem(const PinholeCamera& camera, const SlamOptions& options,
   DETSLAM_CHECK_MSG(camera_.Check(&error), error);
 }
 
+SlamSystem::~SlamSystem() { WaitForGlobalBundleAdjustment(); }
+
+void SlamSystem::WaitForGlobalBundleAdjustment() {
+  if (global_ba_.joinable()) global_ba_.join();
+}
+
+std::vector<LoopRecord> SlamSystem::loops() const {
+  const MapStore::ReadAccess map = store_.Read();
+  return loops_;
+}
+
 void SlamSystem::MapKeyFrame(KeyFrameId kf, FrameReport* report) {
   const auto t0 = std::chrono::steady_clock::now();
   const LocalMappingSummary s = mapper_.ProcessKeyFrame(kf, &store_);
@@ -71,15 +82,32 @@ void SlamSystem::MapKeyFrame(KeyFrameId kf, FrameReport* report) {
       report->loop_inliers = loop.inliers;
       report->loop_agreeing = loop.agreeing;
       report->loop_correction_m = loop.correction_m;
+      loops_.push_back({map->keyframe(loop.keyframe).frame_index, loop.keyframe, loop.candidate,
+                        report->loop_candidate_frame, loop.inliers, loop.agreeing,
+                        loop.correction_m});
+      ++loop_generation_;
       global_ba = options_.loop.global_ba_iterations > 0;
     }
   }
   if (global_ba) {
-    // Without the lock: with a mapping thread, tracking goes on while the whole map is solved.
-    GlobalBundleAdjustment(camera_, options_.loop.global_ba_iterations, &store_,
-                           [this](Map& map, const std::map<KeyFrameId, Rigid3d>& old_poses) {
-                             tracker_.OnLoopClosed(map, old_poses);
-                           });
+    // Without the lock: tracking (and, in its own thread, local mapping) goes on while the whole
+    // map is solved; the result is applied under the lock, where the tracker is updated too.
+    // A solution started before a newer loop's correction would undo it: discarded (ORB-SLAM3
+    // stops its global BA thread for that).
+    auto run = [this, generation = loop_generation_] {
+      GlobalBundleAdjustment(
+          camera_, options_.loop.global_ba_iterations, &store_,
+          [this](Map& map, const std::map<KeyFrameId, Rigid3d>& old_poses) {
+            tracker_.OnLoopClosed(map, old_poses);
+          },
+          [this, generation](const Map&) { return loop_generation_ == generation; });
+    };
+    if (options_.global_ba_thread) {
+      WaitForGlobalBundleAdjustment();  // one at a time
+      global_ba_ = std::thread(run);
+    } else {
+      run();
+    }
   }
   report->timings.mapping_ms = MsSince(t0);
   mapping_times_ms_.push_back(report->timings.mapping_ms);

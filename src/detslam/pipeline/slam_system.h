@@ -7,6 +7,7 @@
 #include <memory>
 #include <opencv2/core.hpp>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "detslam/dynamic/detslam_stage.h"
@@ -31,7 +32,23 @@ struct SlamOptions {
   // (DefaultVocabularyPath), or "none": no place recognition (relocalisation tries every keyframe
   // by brute force, loops are found by position only).
   std::string vocabulary;
+  // The global bundle adjustment after a loop: false (default) runs it in the mapping stage right
+  // after the loop (deterministic); true runs it in a thread of its own, so that neither tracking
+  // nor local mapping waits for it (the threaded runner with a mapping thread sets this). A new
+  // loop waits for the previous one's to finish.
+  bool global_ba_thread = false;
   bool Check(std::string* error) const;
+};
+
+// One loop closed (run.json `loops`).
+struct LoopRecord {
+  int64_t frame = -1;                  // input frame of the keyframe that closed it
+  KeyFrameId keyframe = kNoKeyFrame;   // that keyframe
+  KeyFrameId candidate = kNoKeyFrame;  // the older keyframe of the same place
+  int64_t candidate_frame = -1;        // and the input frame it was made from
+  int inliers = 0;                     // verified inliers
+  int agreeing = 0;                    // keyframes that agreed on it
+  double correction_m = 0;             // how far the pose graph moved the keyframe
 };
 
 // Wall-clock time of each stage for one frame, milliseconds.
@@ -72,6 +89,7 @@ class SlamSystem {
              Segmenter* segmenter = nullptr);
   SlamSystem(const SlamSystem&) = delete;
   SlamSystem& operator=(const SlamSystem&) = delete;
+  ~SlamSystem();
 
   // Processes one RGB-D frame in the calling thread: ExtractFrame, TrackFrame and, for a new
   // keyframe, MapKeyFrame. gray: CV_8UC1; depth_m: CV_32FC1 metres (0 = missing); ignore_mask:
@@ -106,6 +124,10 @@ class SlamSystem {
   std::vector<double> mapping_times_ms() const;
   // Loops closed so far.
   int loops_closed() const;
+  std::vector<LoopRecord> loops() const;
+  // Waits for a global bundle adjustment running in its own thread (global_ba_thread), e.g.
+  // before the trajectory is written. Also done by the destructor.
+  void WaitForGlobalBundleAdjustment();
   LoopDetectionStats loop_detection_stats() const;
   // The vocabulary file in use ("none" without place recognition).
   const std::string& vocabulary_path() const { return vocabulary_path_; }
@@ -131,6 +153,9 @@ class SlamSystem {
   std::vector<TrackedFrame> tracked_;
   std::map<KeyFrameId, ErasedKeyFrame> erased_;
   std::vector<double> mapping_times_ms_;
+  std::vector<LoopRecord> loops_;
+  std::thread global_ba_;  // with global_ba_thread: the running (or last) global BA
+  int loop_generation_ = 0;  // loops corrected so far (a global BA started before one is stale)
 };
 
 ScaleInfo MakeScaleInfo(const OrbExtractor& extractor);

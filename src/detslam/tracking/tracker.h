@@ -95,6 +95,7 @@ class Tracker {
   static constexpr size_t kMinRelocalizationMatches =
       15;  // Relocalization: candidate keyframe matches
   static constexpr double kRelocalizationRatio = 0.75;  //   and its matcher's ratio
+  static constexpr int kRelocalizationWindowKeyFrames = 5;  // covisibles added when too few
   static constexpr int kMinRelocalizationPnpInliers =
       10;                                            // PnP + pose optimisation inliers to go on
   static constexpr int kRelocalizationInliers = 50;  // inliers that accept a relocalisation; also

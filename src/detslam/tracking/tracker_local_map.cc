@@ -115,9 +115,20 @@ bool Tracker::Relocalize(const Map& map, Frame* frame) {
   }
   spdlog::debug("frame {}: {} relocalisation candidates", frame->index, kfs.size());
   for (KeyFrameId kf_id : kfs) {
-    const std::vector<LandmarkId> matched = MatchKeyFrameLandmarks(
-        map.keyframe(kf_id), f, kRelocalizationRatio, kThLow,
-        by_words ? DescriptorSearch::kVocabularyNode : DescriptorSearch::kBruteForce);
+    const DescriptorSearch search =
+        by_words ? DescriptorSearch::kVocabularyNode : DescriptorSearch::kBruteForce;
+    std::vector<LandmarkId> matched =
+        MatchKeyFrameLandmarks(map.keyframe(kf_id), f, kRelocalizationRatio, kThLow, search);
+    if (static_cast<size_t>(std::count_if(matched.begin(), matched.end(), [](LandmarkId id) {
+          return id != kNoLandmark;
+        })) < kMinRelocalizationMatches) {
+      // Too few with the keyframe alone: a frame seen from elsewhere may share more with the
+      // keyframe's neighbourhood (as a loop candidate's window is matched).
+      std::vector<const KeyFrame*> window{&map.keyframe(kf_id)};
+      for (KeyFrameId n : map.BestCovisibles(kf_id, kRelocalizationWindowKeyFrames))
+        window.push_back(&map.keyframe(n));
+      matched = MatchKeyFramesLandmarks(window, f, kRelocalizationRatio, kThLow, search);
+    }
     std::vector<size_t> kp_index;
     std::vector<Eigen::Vector3d> pts;
     std::vector<Eigen::Vector2d> px;
