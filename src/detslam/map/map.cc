@@ -15,12 +15,36 @@ int Landmark::PredictScale(double distance, const ScaleInfo& scale) const {
   return std::clamp(level, 0, scale.num_levels() - 1);
 }
 
+Map::Map(const Map& other)
+    : scale_(other.scale_),
+      keyframes_(other.keyframes_),
+      landmarks_(other.landmarks_),
+      place_index_(other.place_index_),
+      next_keyframe_id_(other.next_keyframe_id_),
+      next_landmark_id_(other.next_landmark_id_) {
+  RebuildIndex();
+}
+
+Map& Map::operator=(const Map& other) {
+  if (this != &other) *this = Map(other);
+  return *this;
+}
+
+void Map::RebuildIndex() {
+  keyframe_at_.assign(static_cast<size_t>(next_keyframe_id_), nullptr);
+  for (auto& [id, kf] : keyframes_) keyframe_at_[static_cast<size_t>(id)] = &kf;
+  landmark_at_.assign(static_cast<size_t>(next_landmark_id_), nullptr);
+  for (auto& [id, lm] : landmarks_) landmark_at_[static_cast<size_t>(id)] = &lm;
+}
+
 KeyFrameId Map::AddKeyFrame(KeyFrame kf) {
   kf.id = next_keyframe_id_++;
   kf.landmarks.assign(kf.features->size(), kNoLandmark);
   const KeyFrameId id = kf.id;
   if (!kf.features->bow.empty()) place_index_.Insert(id, kf.features->bow);
-  keyframes_.emplace(id, std::move(kf));
+  KeyFrame* stored = &keyframes_.emplace(id, std::move(kf)).first->second;
+  keyframe_at_.resize(static_cast<size_t>(next_keyframe_id_), nullptr);
+  keyframe_at_[static_cast<size_t>(id)] = stored;
   return id;
 }
 
@@ -31,29 +55,31 @@ LandmarkId Map::AddLandmark(const Eigen::Vector3d& position, KeyFrameId referenc
   lm.reference_keyframe = reference;
   lm.first_keyframe = reference;
   const LandmarkId id = lm.id;
-  landmarks_.emplace(id, std::move(lm));
+  Landmark* stored = &landmarks_.emplace(id, std::move(lm)).first->second;
+  landmark_at_.resize(static_cast<size_t>(next_landmark_id_), nullptr);
+  landmark_at_[static_cast<size_t>(id)] = stored;
   return id;
 }
 
 KeyFrame& Map::keyframe(KeyFrameId id) {
-  auto it = keyframes_.find(id);
-  DETSLAM_CHECK_MSG(it != keyframes_.end(), "no keyframe " << id);
-  return it->second;
+  KeyFrame* kf = FindKeyFrame(id);
+  DETSLAM_CHECK_MSG(kf != nullptr, "no keyframe " << id);
+  return *kf;
 }
 const KeyFrame& Map::keyframe(KeyFrameId id) const {
-  auto it = keyframes_.find(id);
-  DETSLAM_CHECK_MSG(it != keyframes_.end(), "no keyframe " << id);
-  return it->second;
+  const KeyFrame* kf = FindKeyFrame(id);
+  DETSLAM_CHECK_MSG(kf != nullptr, "no keyframe " << id);
+  return *kf;
 }
 Landmark& Map::landmark(LandmarkId id) {
-  auto it = landmarks_.find(id);
-  DETSLAM_CHECK_MSG(it != landmarks_.end(), "no landmark " << id);
-  return it->second;
+  Landmark* lm = FindLandmark(id);
+  DETSLAM_CHECK_MSG(lm != nullptr, "no landmark " << id);
+  return *lm;
 }
 const Landmark& Map::landmark(LandmarkId id) const {
-  auto it = landmarks_.find(id);
-  DETSLAM_CHECK_MSG(it != landmarks_.end(), "no landmark " << id);
-  return it->second;
+  const Landmark* lm = FindLandmark(id);
+  DETSLAM_CHECK_MSG(lm != nullptr, "no landmark " << id);
+  return *lm;
 }
 
 void Map::AddObservation(LandmarkId lm_id, KeyFrameId kf_id, size_t idx) {
@@ -75,6 +101,7 @@ void Map::EraseObservation(LandmarkId lm_id, KeyFrameId kf_id) {
   kf.landmarks[it->second] = kNoLandmark;
   lm.observations.erase(it);
   if (lm.observations.empty()) {
+    landmark_at_[static_cast<size_t>(lm_id)] = nullptr;
     landmarks_.erase(lm_id);
     return;
   }
@@ -85,7 +112,8 @@ void Map::EraseLandmark(LandmarkId lm_id) {
   auto it = landmarks_.find(lm_id);
   if (it == landmarks_.end()) return;
   for (const auto& [kf_id, idx] : it->second.observations)
-    keyframes_.at(kf_id).landmarks[idx] = kNoLandmark;
+    keyframe(kf_id).landmarks[idx] = kNoLandmark;
+  landmark_at_[static_cast<size_t>(lm_id)] = nullptr;
   landmarks_.erase(it);
 }
 
@@ -94,9 +122,10 @@ void Map::ReplaceLandmark(LandmarkId from, LandmarkId into) {
   const std::map<KeyFrameId, size_t> obs = landmark(from).observations;
   const int visible = landmark(from).visible, found = landmark(from).found;
   for (const auto& [kf_id, idx] : obs) {
-    keyframes_.at(kf_id).landmarks[idx] = kNoLandmark;
+    keyframe(kf_id).landmarks[idx] = kNoLandmark;
     if (!landmark(into).observations.count(kf_id)) AddObservation(into, kf_id, idx);
   }
+  landmark_at_[static_cast<size_t>(from)] = nullptr;
   landmarks_.erase(from);
   Landmark& target = landmark(into);
   target.visible += visible;
@@ -124,6 +153,7 @@ void Map::EraseKeyFrame(KeyFrameId kf_id) {
     if (HasKeyFrame(other)) keyframe(other).covisibility.erase(kf_id);
   }
   place_index_.Erase(kf_id);
+  keyframe_at_[static_cast<size_t>(kf_id)] = nullptr;
   keyframes_.erase(kf_id);
 }
 

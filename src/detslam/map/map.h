@@ -53,6 +53,11 @@ struct Landmark {
 class Map {
  public:
   explicit Map(ScaleInfo scale) : scale_(std::move(scale)) {}
+  // Copies rebuild the id -> element index; moves keep it (map nodes do not move).
+  Map(const Map& other);
+  Map& operator=(const Map& other);
+  Map(Map&&) = default;
+  Map& operator=(Map&&) = default;
 
   // Assigns the id; landmarks vector must be all kNoLandmark. A keyframe whose features have a
   // bag-of-words vector enters the place index.
@@ -75,8 +80,8 @@ class Map {
 
   std::vector<KeyFrameId> BestCovisibles(KeyFrameId kf, size_t n, int min_weight = 0) const;
 
-  bool HasKeyFrame(KeyFrameId id) const { return keyframes_.count(id) > 0; }
-  bool HasLandmark(LandmarkId id) const { return landmarks_.count(id) > 0; }
+  bool HasKeyFrame(KeyFrameId id) const { return FindKeyFrame(id) != nullptr; }
+  bool HasLandmark(LandmarkId id) const { return FindLandmark(id) != nullptr; }
   KeyFrame& keyframe(KeyFrameId id);
   const KeyFrame& keyframe(KeyFrameId id) const;
   Landmark& landmark(LandmarkId id);
@@ -95,9 +100,26 @@ class Map {
   int TrackedLandmarks(KeyFrameId kf, int min_obs) const;
 
  private:
+  // O(1) lookups by id (ids are dense: assigned in order from 0); null where erased. The ordered
+  // maps own the elements and give the deterministic iteration order; a lookup in them costs a
+  // root-to-leaf walk, which grows with the map (2 million landmarks: about 21 cache misses).
+  KeyFrame* FindKeyFrame(KeyFrameId id) const {
+    return id >= 0 && static_cast<size_t>(id) < keyframe_at_.size()
+               ? keyframe_at_[static_cast<size_t>(id)]
+               : nullptr;
+  }
+  Landmark* FindLandmark(LandmarkId id) const {
+    return id >= 0 && static_cast<size_t>(id) < landmark_at_.size()
+               ? landmark_at_[static_cast<size_t>(id)]
+               : nullptr;
+  }
+  void RebuildIndex();
+
   ScaleInfo scale_;
   std::map<KeyFrameId, KeyFrame> keyframes_;  // ordered: deterministic iteration
   std::map<LandmarkId, Landmark> landmarks_;
+  std::vector<KeyFrame*> keyframe_at_;  // id -> element of keyframes_ (null: erased)
+  std::vector<Landmark*> landmark_at_;  // id -> element of landmarks_ (null: erased)
   KeyFrameDatabase place_index_;
   KeyFrameId next_keyframe_id_ = 0;
   LandmarkId next_landmark_id_ = 0;
