@@ -73,6 +73,41 @@ TEST(Map, ReplaceLandmarkMovesObservations) {
   EXPECT_EQ(map.landmark(l1).observations.size(), 2u);
 }
 
+TEST(Map, LookupsByIdFollowErasureCopiesAndMoves) {
+  Map map(TestScale());
+  const KeyFrameId a = map.AddKeyFrame(MakeKeyFrame(3, 0));
+  const KeyFrameId b = map.AddKeyFrame(MakeKeyFrame(3, 1));
+  const LandmarkId l1 = map.AddLandmark(Eigen::Vector3d(0, 0, 2), a);
+  const LandmarkId l2 = map.AddLandmark(Eigen::Vector3d(1, 0, 2), b);
+  map.AddObservation(l1, a, 0);
+  map.AddObservation(l2, b, 1);
+  EXPECT_FALSE(map.HasLandmark(kNoLandmark));
+  EXPECT_FALSE(map.HasLandmark(l2 + 1));  // never made
+  EXPECT_FALSE(map.HasKeyFrame(kNoKeyFrame));
+  // A copy has its own elements: changing or erasing in it leaves the original alone.
+  Map copy = map;
+  copy.landmark(l1).position.x() = 5;
+  copy.EraseLandmark(l2);
+  copy.EraseKeyFrame(b);
+  EXPECT_FALSE(copy.HasLandmark(l2));
+  EXPECT_FALSE(copy.HasKeyFrame(b));
+  EXPECT_TRUE(map.HasLandmark(l2));
+  EXPECT_TRUE(map.HasKeyFrame(b));
+  EXPECT_EQ(map.landmark(l1).position.x(), 0);
+  EXPECT_EQ(copy.landmark(l1).position.x(), 5);
+  // New ids continue after the copied ones.
+  EXPECT_EQ(copy.AddLandmark(Eigen::Vector3d::Zero(), a), l2 + 1);
+  EXPECT_TRUE(copy.HasLandmark(l2 + 1));
+  EXPECT_FALSE(map.HasLandmark(l2 + 1));
+  // A moved map keeps its lookups.
+  Map moved = std::move(copy);
+  EXPECT_EQ(moved.landmark(l1).position.x(), 5);
+  EXPECT_EQ(moved.keyframe(a).landmarks[0], l1);
+  map = moved;  // copy assignment
+  EXPECT_FALSE(map.HasKeyFrame(b));
+  EXPECT_EQ(map.landmark(l1).position.x(), 5);
+}
+
 TEST(Map, EraseKeyFrameReparentsChildrenAndDropsObservations) {
   Map map(TestScale());
   const KeyFrameId a = map.AddKeyFrame(MakeKeyFrame(4, 0));
