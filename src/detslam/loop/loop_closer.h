@@ -93,6 +93,8 @@ class LoopCloser {
 
   int loops_closed() const { return loops_closed_; }
   const LoopDetectionStats& stats() const { return stats_; }
+  // A loop verified but not yet agreed on by enough keyframes: the next keyframes decide.
+  bool has_pending() const { return pending_.has_value(); }
 
  private:
   struct Verified {

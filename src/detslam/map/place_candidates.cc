@@ -4,13 +4,6 @@
 #include <unordered_map>
 
 namespace detslam {
-namespace {
-
-// Covisibility weight from which two keyframes count as connected (ORB-SLAM's threshold of 15
-// shared map points).
-constexpr int kConnectedMinWeight = 15;
-
-}  // namespace
 
 std::vector<PlaceCandidate> QueryPlaceCandidates(const Map& map, const BowVector& bow,
                                                  const PlaceQueryOptions& options) {
@@ -72,17 +65,11 @@ std::vector<PlaceCandidate> LoopCandidates(const Map& map, KeyFrameId kf,
   PlaceQueryOptions options;
   options.exclude = exclude;
   options.exclude.insert(kf);
-  double min_score = 1.0;
-  bool any_neighbour = false;
   for (const auto& [other, weight] : query.covisibility) {
+    (void)weight;
     options.exclude.insert(other);
-    if (weight < kConnectedMinWeight || !map.HasKeyFrame(other)) continue;
-    const BowVector& other_bow = map.keyframe(other).features->bow;
-    if (other_bow.empty()) continue;
-    min_score = std::min(min_score, ScoreL1(bow, other_bow));
-    any_neighbour = true;
   }
-  options.min_score = any_neighbour ? min_score : 0.0;
+  options.min_group_ratio = 0.0;  // every group, best first: the caller takes the best few
   return QueryPlaceCandidates(map, bow, options);
 }
 

@@ -36,9 +36,10 @@ std::vector<PlaceCandidate> QueryPlaceCandidates(const Map& map, const BowVector
 // Relocalisation: candidates for a frame's bag-of-words vector among all keyframes.
 std::vector<PlaceCandidate> RelocalizationCandidates(const Map& map, const BowVector& bow);
 
-// Loop detection for keyframe `kf` (ORB-SLAM2's DetectLoopCandidates): its covisible keyframes and
-// itself are excluded, and the minimum score is the lowest score between `kf` and its covisible
-// keyframes (so a candidate must look at least as similar as the keyframe's own neighbours).
+// Loop detection for keyframe `kf` (ORB-SLAM3's DetectNBestCandidates): keyframes sharing at least
+// 80 % of the most words in common, scored, accumulated over their 10 best covisibles, every group
+// best first (the caller takes the best few; no minimum score: geometric verification and the
+// agreement of several keyframes decide). `kf` and its covisible keyframes are excluded;
 // `exclude` adds keyframes to leave out (e.g. recent ones).
 std::vector<PlaceCandidate> LoopCandidates(const Map& map, KeyFrameId kf,
                                            const std::set<KeyFrameId>& exclude = {});

@@ -106,7 +106,8 @@ void PropagateBundleCorrection(const MapBundle& bundle, const std::map<KeyFrameI
 
 BundleSummary GlobalBundleAdjustment(const PinholeCamera& camera, int iterations, MapStore* store,
                                      const MapUpdatedFn& applied,
-                                     const std::function<bool(const Map&)>& still_valid) {
+                                     const std::function<bool(const Map&)>& still_valid,
+                                     const std::atomic<bool>* abort_flag) {
   BundleSummary summary;
   auto snapshot = [](const Map& map) -> std::optional<MapBundle> {
     std::vector<KeyFrameId> all;
@@ -121,7 +122,7 @@ BundleSummary GlobalBundleAdjustment(const PinholeCamera& camera, int iterations
   auto solve = [&](MapBundle& b) {
     BundleOptions bo;
     bo.max_iterations = iterations;
-    summary = SolveBundle(camera, &b.problem, bo);
+    summary = SolveBundle(camera, &b.problem, bo, abort_flag);
     return summary.usable;
   };
   auto apply = [&](Map& map, const MapBundle& b, bool usable) {

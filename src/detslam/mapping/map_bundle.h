@@ -3,6 +3,7 @@
 // after loop closing).
 #pragma once
 
+#include <atomic>
 #include <functional>
 #include <map>
 #include <utility>
@@ -45,11 +46,13 @@ void PropagateBundleCorrection(const MapBundle& bundle, const std::map<KeyFrameI
 // reference keyframe's. `applied` (may be empty) runs under the same lock right after the update,
 // with every keyframe's pose before it (e.g. to move the tracker's last frame). `still_valid` (may
 // be empty), checked under the lock before the update, can discard a solution that the map has
-// outgrown (e.g. a newer loop correction). Returns the solver summary (not usable, or discarded:
-// nothing changed).
+// outgrown (e.g. a newer loop correction). When *abort_flag (may be null) becomes true the solver
+// stops after its current iteration (ORB-SLAM3 stops its global BA when a new loop is found).
+// Returns the solver summary (not usable, or discarded: nothing changed).
 using MapUpdatedFn = std::function<void(Map&, const std::map<KeyFrameId, Rigid3d>& old_poses)>;
 BundleSummary GlobalBundleAdjustment(const PinholeCamera& camera, int iterations, MapStore* store,
                                      const MapUpdatedFn& applied = nullptr,
-                                     const std::function<bool(const Map&)>& still_valid = nullptr);
+                                     const std::function<bool(const Map&)>& still_valid = nullptr,
+                                     const std::atomic<bool>* abort_flag = nullptr);
 
 }  // namespace detslam

@@ -2,6 +2,10 @@
 
 #include <gtest/gtest.h>
 
+#include <atomic>
+#include <memory>
+#include <random>
+
 namespace detslam {
 namespace {
 
@@ -64,6 +68,90 @@ TEST(PropagateBundleCorrection, NewcomersMoveWithTheirParentAndReference) {
   EXPECT_NEAR(map.keyframe(k2).Center().y(), 0.1, 1e-12);
   EXPECT_NEAR(map.landmark(new_point).position.y(), 0.6, 1e-12);  // with keyframe 2
   EXPECT_NEAR(map.keyframe(k0).Center().y(), 0.0, 1e-12);         // the anchor stays
+}
+
+// Three keyframes that see the same 40 points; the landmarks are perturbed so that the bundle has
+// something to do. Returns the store.
+void FillNoisyMap(const PinholeCamera& camera, Map* map) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> lateral(-1.0, 1.0), depth(2.0, 3.0), noise(-0.05, 0.05);
+  std::vector<Eigen::Vector3d> points;
+  for (int i = 0; i < 40; ++i) points.emplace_back(lateral(rng), 0.6 * lateral(rng), depth(rng));
+  std::vector<KeyFrameId> kfs;
+  for (int k = 0; k < 3; ++k) {
+    KeyFrame kf;
+    kf.cam_from_world = Rigid3d(Eigen::Quaterniond::Identity(), Eigen::Vector3d(-0.2 * k, 0, 0));
+    auto f = std::make_shared<FrameFeatures>();
+    for (const Eigen::Vector3d& p : points) {
+      const Eigen::Vector3d pc = kf.cam_from_world * p;
+      const Eigen::Vector2d uv = camera.Project(pc);
+      f->keypoints.emplace_back(static_cast<float>(uv.x()), static_cast<float>(uv.y()), 31.0f,
+                                0.0f, 1.0f, 0);
+      f->undist.push_back(uv);
+      f->depth.push_back(static_cast<float>(pc.z()));
+      f->u_right.push_back(static_cast<float>(uv.x() - camera.bf / pc.z()));
+    }
+    f->descriptors = cv::Mat(static_cast<int>(points.size()), 32, CV_8UC1, cv::Scalar(7));
+    kf.features = f;
+    kfs.push_back(map->AddKeyFrame(std::move(kf)));
+  }
+  for (size_t i = 0; i < points.size(); ++i) {
+    const Eigen::Vector3d off(noise(rng), noise(rng), noise(rng));
+    const LandmarkId lm = map->AddLandmark(points[i] + off, kfs[0]);
+    for (KeyFrameId k : kfs) map->AddObservation(lm, k, i);
+  }
+  for (KeyFrameId k : kfs) map->UpdateConnections(k);
+}
+
+double MeanPointError(const Map& map, const PinholeCamera& camera) {
+  double sum = 0;
+  int n = 0;
+  const KeyFrame& kf = map.keyframe(map.first_keyframe());
+  for (size_t i = 0; i < kf.landmarks.size(); ++i) {
+    const Eigen::Vector3d truth = camera.Unproject(kf.features->undist[i], kf.features->depth[i]);
+    sum += (map.landmark(kf.landmarks[i]).position - truth).norm();
+    ++n;
+  }
+  return sum / n;
+}
+
+TEST(GlobalBundleAdjustment, SolvesStopsOnRequestAndDiscardsAnOutgrownSolution) {
+  const PinholeCamera camera;
+  auto fresh = [&] {
+    auto store = std::make_unique<MapStore>(ScaleInfo::Geometric(1.2, 8));
+    FillNoisyMap(camera, &*store->Write());
+    return store;
+  };
+  auto error = [&](MapStore& store) { return MeanPointError(*store.Read(), camera); };
+
+  auto solved = fresh();
+  const double before = error(*solved);
+  ASSERT_GT(before, 0.02);
+  int applied = 0;
+  const BundleSummary full = GlobalBundleAdjustment(
+      camera, 10, solved.get(), [&](Map&, const std::map<KeyFrameId, Rigid3d>&) { ++applied; });
+  EXPECT_TRUE(full.usable);
+  EXPECT_EQ(applied, 1);
+  EXPECT_GT(full.iterations, 1);
+  EXPECT_LT(error(*solved), 0.1 * before);
+
+  // Asked to stop: at most one iteration, and what it did is kept.
+  auto stopped = fresh();
+  const std::atomic<bool> stop{true};
+  const BundleSummary early =
+      GlobalBundleAdjustment(camera, 10, stopped.get(), nullptr, nullptr, &stop);
+  EXPECT_LE(early.iterations, 1);
+  EXPECT_LT(early.iterations, full.iterations);
+
+  // A solution the map has outgrown (still_valid false under the lock) changes nothing.
+  auto outgrown = fresh();
+  applied = 0;
+  const BundleSummary discarded = GlobalBundleAdjustment(
+      camera, 10, outgrown.get(), [&](Map&, const std::map<KeyFrameId, Rigid3d>&) { ++applied; },
+      [](const Map&) { return false; });
+  EXPECT_FALSE(discarded.usable);
+  EXPECT_EQ(applied, 0);
+  EXPECT_DOUBLE_EQ(error(*outgrown), before);
 }
 
 }  // namespace

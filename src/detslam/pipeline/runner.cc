@@ -85,6 +85,7 @@ void WriteOutputs(const RgbdDataset& dataset, const Settings& settings, const Ru
                          {"pending_confirmed", ld.pending_confirmed},
                          {"pending_dropped", ld.pending_dropped},
                          {"revisits", ld.revisits}};
+  j["global_ba"] = {{"runs", summary.global_ba_runs}, {"stopped", summary.global_ba_stopped}};
   j["vocabulary"] = slam.vocabulary_path();
   j["wall_s"] = summary.wall_s;
   j["segmenter"] = summary.segmenter.empty() ? "none" : summary.segmenter;
@@ -171,6 +172,8 @@ class RunRecorder {
     summary_.loops = static_cast<size_t>(slam.loops_closed());
     summary_.loop_records = slam.loops();
     summary_.loop_detection = slam.loop_detection_stats();
+    summary_.global_ba_runs = slam.global_ba_runs();
+    summary_.global_ba_stopped = slam.global_ba_stopped();
     {
       const MapStore::ReadAccess map = slam.ReadMap();
       summary_.keyframes = map->NumKeyFrames();

@@ -36,6 +36,8 @@ struct RunSummary {
   size_t relocalizations = 0;
   size_t loops = 0;  // loops closed
   LoopDetectionStats loop_detection;
+  int global_ba_runs = 0;     // global bundle adjustments started after loops
+  int global_ba_stopped = 0;  // ... stopped early by a newer loop (solution discarded)
   std::vector<LoopRecord> loop_records;
   double wall_s = 0;
   ErrorStats segmentation, extraction, tracking, mapping, total;  // per-stage times, ms

@@ -5,6 +5,8 @@
 #include <cmath>
 #include <sstream>
 
+#include <spdlog/spdlog.h>
+
 #include "detslam/core/check.h"
 #include "detslam/mapping/map_bundle.h"
 #include "detslam/place/default_vocabulary.h"
@@ -51,7 +53,10 @@ SlamSystem::SlamSystem(const PinholeCamera& camera, const SlamOptions& options,
   DETSLAM_CHECK_MSG(camera_.Check(&error), error);
 }
 
-SlamSystem::~SlamSystem() { WaitForGlobalBundleAdjustment(); }
+SlamSystem::~SlamSystem() {
+  stop_global_ba_ = true;
+  WaitForGlobalBundleAdjustment();
+}
 
 void SlamSystem::WaitForGlobalBundleAdjustment() {
   if (global_ba_.joinable()) global_ba_.join();
@@ -73,6 +78,7 @@ void SlamSystem::MapKeyFrame(KeyFrameId kf, FrameReport* report) {
       tracker_.OnKeyFrameErased(*map, e.id);
     }
     const LoopClosingResult loop = loop_closer_.Process(*map, kf);
+    if (loop_closer_.has_pending()) tracker_.RequestKeyFrame();
     if (loop.closed) {
       tracker_.OnLoopClosed(*map, loop.old_poses);
       report->loop_closed = true;
@@ -92,18 +98,29 @@ void SlamSystem::MapKeyFrame(KeyFrameId kf, FrameReport* report) {
   if (global_ba) {
     // Without the lock: tracking (and, in its own thread, local mapping) goes on while the whole
     // map is solved; the result is applied under the lock, where the tracker is updated too.
-    // A solution started before a newer loop's correction would undo it: discarded (ORB-SLAM3
-    // stops its global BA thread for that).
+    // A solution started before a newer loop's correction would undo it: the running one is
+    // stopped after its current iteration and its solution discarded (ORB-SLAM3 stops its global
+    // BA thread for a new loop too).
     auto run = [this, generation = loop_generation_] {
       GlobalBundleAdjustment(
           camera_, options_.loop.global_ba_iterations, &store_,
           [this](Map& map, const std::map<KeyFrameId, Rigid3d>& old_poses) {
             tracker_.OnLoopClosed(map, old_poses);
           },
-          [this, generation](const Map&) { return loop_generation_ == generation; });
+          [this, generation](const Map&) { return loop_generation_ == generation; },
+          &stop_global_ba_);
+      global_ba_running_ = false;
     };
+    ++global_ba_runs_;
     if (options_.global_ba_thread) {
-      WaitForGlobalBundleAdjustment();  // one at a time
+      if (global_ba_running_) {  // one at a time: a newer loop stops the running one
+        stop_global_ba_ = true;
+        ++global_ba_stopped_;
+        spdlog::info("global bundle adjustment stopped: a newer loop was closed");
+      }
+      WaitForGlobalBundleAdjustment();
+      stop_global_ba_ = false;
+      global_ba_running_ = true;
       global_ba_ = std::thread(run);
     } else {
       run();
@@ -117,6 +134,10 @@ std::vector<double> SlamSystem::mapping_times_ms() const {
   const MapStore::ReadAccess map = store_.Read();
   return mapping_times_ms_;
 }
+
+int SlamSystem::global_ba_runs() const { return global_ba_runs_; }
+
+int SlamSystem::global_ba_stopped() const { return global_ba_stopped_; }
 
 int SlamSystem::loops_closed() const {
   const MapStore::ReadAccess map = store_.Read();

@@ -3,6 +3,7 @@
 // reference keyframe (so later map corrections move the frames with their keyframes).
 #pragma once
 
+#include <atomic>
 #include <map>
 #include <memory>
 #include <opencv2/core.hpp>
@@ -126,8 +127,13 @@ class SlamSystem {
   int loops_closed() const;
   std::vector<LoopRecord> loops() const;
   // Waits for a global bundle adjustment running in its own thread (global_ba_thread), e.g.
-  // before the trajectory is written. Also done by the destructor.
+  // before the trajectory is written. The destructor stops it instead (after its current
+  // iteration, progress kept).
   void WaitForGlobalBundleAdjustment();
+  // Global bundle adjustments started, and those stopped early because a newer loop was closed
+  // while they ran (their solution is discarded: it predates that loop's correction).
+  int global_ba_runs() const;
+  int global_ba_stopped() const;
   LoopDetectionStats loop_detection_stats() const;
   // The vocabulary file in use ("none" without place recognition).
   const std::string& vocabulary_path() const { return vocabulary_path_; }
@@ -156,6 +162,10 @@ class SlamSystem {
   std::vector<LoopRecord> loops_;
   std::thread global_ba_;  // with global_ba_thread: the running (or last) global BA
   int loop_generation_ = 0;  // loops corrected so far (a global BA started before one is stale)
+  std::atomic<bool> stop_global_ba_{false};     // asks the running global BA to stop
+  std::atomic<bool> global_ba_running_{false};  // a global BA thread has not finished yet
+  std::atomic<int> global_ba_runs_{0};
+  std::atomic<int> global_ba_stopped_{0};
 };
 
 ScaleInfo MakeScaleInfo(const OrbExtractor& extractor);

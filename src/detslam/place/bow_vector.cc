@@ -14,46 +14,27 @@ double L1Norm(const BowVector& v) {
 double ScoreL1(const BowVector& a, const BowVector& b) {
   const double na = L1Norm(a), nb = L1Norm(b);
   if (na <= 0.0 || nb <= 0.0) return 0.0;
-  // Merge over the union of words; words in only one vector contribute their full weight.
-  double distance = 0.0;
-  auto ia = a.begin(), ib = b.begin();
-  while (ia != a.end() || ib != b.end()) {
-    if (ib == b.end() || (ia != a.end() && ia->first < ib->first)) {
-      distance += std::abs(ia->second) / na;
-      ++ia;
-    } else if (ia == a.end() || ib->first < ia->first) {
-      distance += std::abs(ib->second) / nb;
-      ++ib;
-    } else {
-      distance += std::abs(ia->second / na - ib->second / nb);
-      ++ia;
-      ++ib;
-    }
-  }
+  // || a' - b' ||_1 over the union of words, with a' = a/|a| and b' = b/|b| (each sums to 1 in
+  // absolute value): 2 minus, over the shared words, |a'| + |b'| - |a' - b'|.
+  double distance = 2.0;
+  ForEachCommonKey(a, b, [&](const auto& x, const auto& y) {
+    const double wa = x.second / na, wb = y.second / nb;
+    distance -= std::abs(wa) + std::abs(wb) - std::abs(wa - wb);
+  });
   return std::clamp(1.0 - 0.5 * distance, 0.0, 1.0);
 }
 
 std::vector<MatchGroup> SharedNodeGroups(const FeatureVector& a, const FeatureVector& b,
                                          const std::vector<bool>& keep_a) {
   std::vector<MatchGroup> groups;
-  auto ia = a.begin();
-  auto ib = b.begin();
-  while (ia != a.end() && ib != b.end()) {
-    if (ia->first < ib->first) {
-      ++ia;
-    } else if (ib->first < ia->first) {
-      ++ib;
-    } else {
-      MatchGroup g;
-      for (const int i : ia->second) {
-        if (keep_a.empty() || keep_a[static_cast<size_t>(i)]) g.a.push_back(i);
-      }
-      g.b = ib->second;
-      if (!g.a.empty() && !g.b.empty()) groups.push_back(std::move(g));
-      ++ia;
-      ++ib;
+  ForEachCommonKey(a, b, [&](const auto& x, const auto& y) {
+    MatchGroup g;
+    for (const int i : x.second) {
+      if (keep_a.empty() || keep_a[static_cast<size_t>(i)]) g.a.push_back(i);
     }
-  }
+    g.b = y.second;
+    if (!g.a.empty() && !g.b.empty()) groups.push_back(std::move(g));
+  });
   return groups;
 }
 

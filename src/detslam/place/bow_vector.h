@@ -29,4 +29,23 @@ std::vector<MatchGroup> SharedNodeGroups(const FeatureVector& a, const FeatureVe
 // Sum of |weights|.
 double L1Norm(const BowVector& v);
 
+// Walks two sequences of (key, value) pairs, both sorted by ascending key, and calls
+// both(x, y) for every key they share, in key order; stops at the end of either.
+template <typename A, typename B, typename Both>
+void ForEachCommonKey(const A& a, const B& b, Both both) {
+  auto ia = a.begin();
+  auto ib = b.begin();
+  while (ia != a.end() && ib != b.end()) {
+    if (ia->first < ib->first) {
+      ++ia;
+    } else if (ib->first < ia->first) {
+      ++ib;
+    } else {
+      both(*ia, *ib);
+      ++ia;
+      ++ib;
+    }
+  }
+}
+
 }  // namespace detslam

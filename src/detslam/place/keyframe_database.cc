@@ -93,20 +93,8 @@ std::vector<KeyFrameDatabase::Result> KeyFrameDatabase::Query(const BowVector& b
     if (common[s] == 0) continue;
     if (options.min_common_ratio > 0.0 && !(common[s] > min_common)) continue;
     double score = 0.0;
-    const FlatBow& kf = bow_of_slot_[s];
-    auto q = query.begin();
-    auto k = kf.begin();
-    while (q != query.end() && k != kf.end()) {
-      if (q->first < k->first) {
-        ++q;
-      } else if (k->first < q->first) {
-        ++k;
-      } else {
-        score += std::min(q->second, k->second);
-        ++q;
-        ++k;
-      }
-    }
+    ForEachCommonKey(query, bow_of_slot_[s],
+                     [&](const auto& q, const auto& k) { score += std::min(q.second, k.second); });
     const double clipped = std::min(score, 1.0);
     if (clipped > 0.0 && clipped >= options.min_score) {
       results.push_back({id_of_slot_[s], clipped, common[s]});

@@ -81,6 +81,11 @@ class Tracker {
   // Called after loop closing moved the keyframes (`old_poses`: their poses before): moves the
   // last frame with its reference keyframe.
   void OnLoopClosed(const Map& map, const std::map<KeyFrameId, Rigid3d>& old_poses);
+  // Asks for one keyframe as soon as max_frames_between_keyframes have passed since the last one,
+  // even where the usual criteria would not take one (tracking still needs enough inliers): loop
+  // closing asks while a verified loop waits for more keyframes to agree, which on a revisit of
+  // well-tracked ground would otherwise come seconds apart.
+  void RequestKeyFrame() { keyframe_requested_ = true; }
 
  private:
   // ORB-SLAM3's fixed tracking thresholds (Tracking.cc, RGB-D), named.
@@ -152,6 +157,7 @@ class Tracker {
   KeyFrameId reference_kf_ = kNoKeyFrame;
   KeyFrameId last_keyframe_ = kNoKeyFrame;
   int64_t last_keyframe_frame_ = 0;
+  bool keyframe_requested_ = false;  // RequestKeyFrame; cleared by the next keyframe
   int64_t last_reloc_frame_ = -1000000;
   Timestamp lost_since_;
   std::vector<KeyFrameId> local_keyframes_;

@@ -212,6 +212,7 @@ bool Tracker::NeedNewKeyFrame(const Map& map, const Frame& frame, int inliers) c
   const bool c1b = true;  // sequential mapping: the local mapper is always idle here
   const bool c1c = inliers < kNewKeyFrameLowRatio * ref_matches || need_close;
   const bool c2 = (inliers < th_ref * ref_matches || need_close) && inliers > kMinKeyFrameInliers;
+  if (keyframe_requested_ && c1a && inliers > kMinKeyFrameInliers) return true;
   return (c1a || c1b || c1c) && c2;
 }
 
@@ -232,6 +233,7 @@ KeyFrameId Tracker::CreateKeyFrame(Map& map, Frame* frame) {
   reference_kf_ = id;
   last_keyframe_ = id;
   last_keyframe_frame_ = frame->index;
+  keyframe_requested_ = false;
   frame->reference_keyframe = id;
   if (last_frame_ && last_frame_->index == frame->index) {
     last_frame_->landmarks = frame->landmarks;
