@@ -27,6 +27,7 @@ struct RunArgs {
   int64_t max_frames = -1;
   double max_dt = 0.02;
   bool no_progress = false;
+  std::string save_map;
   bool threaded = false;
   bool inline_mapping = false;
   std::string segmenter;  // empty: dnn if the models are found, else none
@@ -75,6 +76,7 @@ void Run(const RunArgs& a) {
   RunOptions options;
   options.out_dir = a.out;
   options.max_frames = a.max_frames;
+  options.save_map = a.save_map;
   options.threaded = a.threaded;
   options.slam = SlamOptionsFromSettings(settings, a.seed);
   options.mapping_thread = a.threaded && !a.inline_mapping;
@@ -112,6 +114,7 @@ void Run(const RunArgs& a) {
   const fs::path out(a.out);
   std::printf("outputs: %s %s %s %s\n", (out / "trajectory.txt").c_str(), (out / "keyframes.txt").c_str(),
               (out / "map.ply").c_str(), (out / "run.json").c_str());
+  if (!a.save_map.empty()) std::printf("map file: %s (%.1f MB)\n", a.save_map.c_str(), s.map_file_bytes / 1e6);
   if (!dataset.groundtruth_path().empty()) {
     std::printf("evaluate: detslam eval --gt %s --est %s --frames %s\n", dataset.groundtruth_path().c_str(),
                 (out / "trajectory.txt").c_str(), dataset.dir().c_str());
@@ -151,6 +154,8 @@ void AddRunCommand(CLI::App& app) {
   cmd->add_flag("--inline-mapping", args->inline_mapping,
                 "With --threaded: local mapping in the tracking thread (then the trajectory equals the sequential one)");
   cmd->add_flag("--no-progress", args->no_progress, "No progress bar");
+  cmd->add_option("--save-map", args->save_map,
+                  "Write the final map to this map file (keyframes, map points, covisibility; `detslam map info FILE`)");
   cmd->callback([args] { Run(*args); });
 }
 

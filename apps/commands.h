@@ -22,5 +22,6 @@ void AddSegmentCommand(CLI::App& app);
 void AddReportCommand(CLI::App& app);
 void AddSettingsCommand(CLI::App& app);
 void AddVocabCommand(CLI::App& app);
+void AddMapCommand(CLI::App& app);
 
 }  // namespace detslam::app

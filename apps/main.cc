@@ -22,6 +22,7 @@ int main(int argc, char** argv) {
   detslam::app::AddReportCommand(app);
   detslam::app::AddSettingsCommand(app);
   detslam::app::AddVocabCommand(app);
+  detslam::app::AddMapCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

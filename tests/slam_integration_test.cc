@@ -14,8 +14,10 @@
 #include "detslam/eval/run_log.h"
 #include "detslam/io/dataset.h"
 #include "detslam/io/settings.h"
+#include "detslam/map/map_file.h"
 #include "detslam/pipeline/runner.h"
 #include "detslam/pipeline/settings_keys.h"
+#include "detslam/place/default_vocabulary.h"
 #include "detslam/segmentation/segmenter_factory.h"
 #include "detslam/synth/writer.h"
 #include "support/shared_data.h"
@@ -196,6 +198,36 @@ TEST(IntegrationSlamSynthetic, StaticPresetTracksEveryFrameWithinOneCentimetre) 
   EXPECT_EQ(j["effective_settings"]["Dynamic.Classes"], nlohmann::json::array({"person"}));
   EXPECT_EQ(j["effective_settings"]["Segmentation.EveryK"].get<int>(), 1);
   EXPECT_EQ(ReadRunLog(run_json).frames, static_cast<int64_t>(run.summary.frames));
+}
+
+// The map of a real run (culled keyframes, fused points, covisibility, spanning tree) survives
+// save -> load -> save byte for byte, and the loaded map is the run's.
+TEST(IntegrationMapFile, ARunsMapSurvivesSaveLoadSave) {
+  const std::string seq = WriteStaticSequence("map_file", 2, 120);
+  const std::string out = TempDir("map_file_run");
+  const RgbdDataset dataset = RgbdDataset::Open(seq, {});
+  const Settings settings = PresetForDataset(seq);
+  RunOptions options;
+  options.out_dir = out;
+  options.slam = SlamOptionsFromSettings(settings, 42);
+  options.save_map = (fs::path(out) / "map.dslmap").string();
+  const RunSummary summary = detslam::Run(dataset, settings, options, nullptr, nullptr);
+  EXPECT_EQ(summary.tracked, summary.frames);
+
+  MapFileExpectation expected;
+  expected.camera = settings.camera;
+  expected.scale = ScaleInfo::Geometric(options.slam.orb.scale_factor, options.slam.orb.num_levels);
+  expected.vocabulary_checksum = LoadSharedVocabulary(DefaultVocabularyPath())->Checksum();
+  MapFileInfo info;
+  const Map map = LoadMapFile(options.save_map, expected, &info);
+  EXPECT_EQ(info.keyframes, summary.keyframes);
+  EXPECT_EQ(info.landmarks, summary.landmarks);
+  EXPECT_EQ(map.place_index().size(), map.NumKeyFrames());
+  EXPECT_EQ(info.bytes, summary.map_file_bytes);
+  EXPECT_EQ(EncodeMapFile(map, settings.camera, expected.vocabulary_checksum),
+            ReadFile(options.save_map));
+  const nlohmann::json j = nlohmann::json::parse(ReadFile((fs::path(out) / "run.json").string()));
+  EXPECT_EQ(j["map_file"]["bytes"].get<uint64_t>(), info.bytes);
 }
 
 }  // namespace

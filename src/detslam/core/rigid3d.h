@@ -16,6 +16,14 @@ class Rigid3d {
       : rotation_(Eigen::Quaterniond(rotation).normalized()), translation_(translation) {}
 
   static Rigid3d Identity() { return Rigid3d(); }
+  // From a rotation that is already unit (e.g. read back from a file): stored bit for bit, not
+  // normalised again, so that a pose survives a write-read round trip exactly.
+  static Rigid3d FromUnitQuaternion(const Eigen::Quaterniond& unit, const Eigen::Vector3d& t) {
+    Rigid3d r;
+    r.rotation_ = unit;
+    r.translation_ = t;
+    return r;
+  }
   // From a 4x4 homogeneous matrix (the rotation block is re-orthonormalised via the quaternion).
   static Rigid3d FromMatrix(const Eigen::Matrix4d& m) {
     return Rigid3d(Eigen::Matrix3d(m.topLeftCorner<3, 3>()),

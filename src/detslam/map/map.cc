@@ -31,10 +31,74 @@ Map& Map::operator=(const Map& other) {
 }
 
 void Map::RebuildIndex() {
-  keyframe_at_.assign(static_cast<size_t>(next_keyframe_id_), nullptr);
+  // Sized by the largest id present (ids above it are absent either way), so that a map restored
+  // from a file does not allocate for ids it never uses.
+  keyframe_at_.assign(keyframes_.empty() ? 0 : static_cast<size_t>(keyframes_.rbegin()->first) + 1,
+                      nullptr);
   for (auto& [id, kf] : keyframes_) keyframe_at_[static_cast<size_t>(id)] = &kf;
-  landmark_at_.assign(static_cast<size_t>(next_landmark_id_), nullptr);
+  landmark_at_.assign(landmarks_.empty() ? 0 : static_cast<size_t>(landmarks_.rbegin()->first) + 1,
+                      nullptr);
   for (auto& [id, lm] : landmarks_) landmark_at_[static_cast<size_t>(id)] = &lm;
+}
+
+Map Map::Restore(ScaleInfo scale, std::vector<KeyFrame> keyframes, std::vector<Landmark> landmarks,
+                 KeyFrameId next_keyframe_id, LandmarkId next_landmark_id) {
+  auto fail = [](const std::string& m) { throw InputError(m); };
+  Map map(std::move(scale));
+  if (next_keyframe_id < 0 || next_landmark_id < 0) fail("negative next id");
+  map.next_keyframe_id_ = next_keyframe_id;
+  map.next_landmark_id_ = next_landmark_id;
+  KeyFrameId last_kf = kNoKeyFrame;
+  for (KeyFrame& kf : keyframes) {
+    const std::string where = "keyframe " + std::to_string(kf.id) + ": ";
+    if (kf.id <= last_kf || kf.id >= next_keyframe_id) fail(where + "id not ascending or too large");
+    if (!kf.features) fail(where + "no features");
+    if (!kf.labels.empty() && kf.labels.size() != kf.features->size())
+      fail(where + "labels do not match the keypoints");
+    last_kf = kf.id;
+    kf.landmarks.assign(kf.features->size(), kNoLandmark);
+    kf.children.clear();
+    const KeyFrameId id = kf.id;
+    if (!kf.features->bow.empty()) map.place_index_.Insert(id, kf.features->bow);
+    map.keyframes_.emplace(id, std::move(kf));
+  }
+  LandmarkId last_lm = kNoLandmark;
+  for (Landmark& lm : landmarks) {
+    const std::string where = "map point " + std::to_string(lm.id) + ": ";
+    if (lm.id <= last_lm || lm.id >= next_landmark_id) fail(where + "id not ascending or too large");
+    last_lm = lm.id;
+    for (const auto& [kf_id, idx] : lm.observations) {
+      auto it = map.keyframes_.find(kf_id);
+      if (it == map.keyframes_.end())
+        fail(where + "observed by keyframe " + std::to_string(kf_id) + ", which does not exist");
+      if (idx >= it->second.landmarks.size() || it->second.landmarks[idx] != kNoLandmark) {
+        fail(where + "keypoint " + std::to_string(idx) + " of keyframe " + std::to_string(kf_id) +
+             " is out of range or taken twice");
+      }
+      it->second.landmarks[idx] = lm.id;
+    }
+    const LandmarkId id = lm.id;
+    map.landmarks_.emplace(id, std::move(lm));
+  }
+  for (auto& [id, kf] : map.keyframes_) {
+    const std::string where = "keyframe " + std::to_string(id) + ": ";
+    for (const auto& [other, weight] : kf.covisibility) {
+      auto it = map.keyframes_.find(other);
+      if (other == id || it == map.keyframes_.end() || weight < 1 ||
+          it->second.covisibility.count(id) == 0 || it->second.covisibility.at(id) != weight) {
+        fail(where + "covisibility with keyframe " + std::to_string(other) +
+             " has no matching reverse edge");
+      }
+    }
+    if (kf.parent != kNoKeyFrame) {
+      auto it = map.keyframes_.find(kf.parent);
+      if (kf.parent == id || it == map.keyframes_.end())
+        fail(where + "parent " + std::to_string(kf.parent) + " does not exist");
+      it->second.children.insert(id);
+    }
+  }
+  map.RebuildIndex();
+  return map;
 }
 
 KeyFrameId Map::AddKeyFrame(KeyFrame kf) {

@@ -59,6 +59,18 @@ class Map {
   Map(Map&&) = default;
   Map& operator=(Map&&) = default;
 
+  // A map rebuilt from stored parts (map files): keyframes and landmarks keep their ids (ascending,
+  // below next_keyframe_id / next_landmark_id); keyframe slots are filled from the landmarks'
+  // observations, children from the parents; keyframes with a bag-of-words vector enter the place
+  // index. Throws InputError(message) when the parts break an invariant (an observation of a
+  // missing keyframe or slot, a slot taken twice, a covisibility edge without its reverse, a
+  // parent that does not exist).
+  static Map Restore(ScaleInfo scale, std::vector<KeyFrame> keyframes,
+                     std::vector<Landmark> landmarks, KeyFrameId next_keyframe_id,
+                     LandmarkId next_landmark_id);
+  KeyFrameId next_keyframe_id() const { return next_keyframe_id_; }
+  LandmarkId next_landmark_id() const { return next_landmark_id_; }
+
   // Assigns the id; landmarks vector must be all kNoLandmark. A keyframe whose features have a
   // bag-of-words vector enters the place index.
   KeyFrameId AddKeyFrame(KeyFrame kf);

@@ -25,7 +25,7 @@ nlohmann::json StatsJson(const ErrorStats& s) {
 }
 
 void WriteOutputs(const RgbdDataset& dataset, const Settings& settings, const RunOptions& options,
-                  const SlamSystem& slam, const RunSummary& summary) {
+                  const SlamSystem& slam, RunSummary& summary) {
   namespace fs = std::filesystem;
   const fs::path out(options.out_dir);
   const std::string header = "detslam trajectory (world_from_camera) of " + dataset.dir() +
@@ -39,6 +39,7 @@ void WriteOutputs(const RgbdDataset& dataset, const Settings& settings, const Ru
     points.push_back(lm.position);
   }
   WritePointCloudPly((out / "map.ply").string(), points, {});
+  if (!options.save_map.empty()) summary.map_file_bytes = slam.SaveMap(options.save_map);
   nlohmann::json j;
   j["dataset"] = dataset.dir();
   j["settings"] = settings.source;
@@ -86,6 +87,8 @@ void WriteOutputs(const RgbdDataset& dataset, const Settings& settings, const Ru
                          {"pending_dropped", ld.pending_dropped},
                          {"revisits", ld.revisits}};
   j["global_ba"] = {{"runs", summary.global_ba_runs}, {"stopped", summary.global_ba_stopped}};
+  if (!options.save_map.empty())
+    j["map_file"] = {{"path", options.save_map}, {"bytes", summary.map_file_bytes}};
   j["vocabulary"] = slam.vocabulary_path();
   j["wall_s"] = summary.wall_s;
   j["segmenter"] = summary.segmenter.empty() ? "none" : summary.segmenter;

@@ -21,6 +21,7 @@ struct RunOptions {
   bool threaded = false;        // one thread per stage (see RunThreaded)
   bool mapping_thread = false;  // threaded: local mapping in its own thread (not deterministic)
   size_t queue_capacity = 4;    // frames buffered between the threaded stages
+  std::string save_map;         // write the final map to this map file (empty: none)
   SlamOptions slam;
 };
 
@@ -38,6 +39,7 @@ struct RunSummary {
   LoopDetectionStats loop_detection;
   int global_ba_runs = 0;     // global bundle adjustments started after loops
   int global_ba_stopped = 0;  // ... stopped early by a newer loop (solution discarded)
+  uint64_t map_file_bytes = 0;  // size of the map file written (save_map)
   std::vector<LoopRecord> loop_records;
   double wall_s = 0;
   ErrorStats segmentation, extraction, tracking, mapping, total;  // per-stage times, ms

@@ -7,7 +7,9 @@
 
 #include <spdlog/spdlog.h>
 
+#include "detslam/core/atomic_file.h"
 #include "detslam/core/check.h"
+#include "detslam/map/map_file.h"
 #include "detslam/mapping/map_bundle.h"
 #include "detslam/place/default_vocabulary.h"
 
@@ -133,6 +135,16 @@ void SlamSystem::MapKeyFrame(KeyFrameId kf, FrameReport* report) {
 std::vector<double> SlamSystem::mapping_times_ms() const {
   const MapStore::ReadAccess map = store_.Read();
   return mapping_times_ms_;
+}
+
+uint64_t SlamSystem::SaveMap(const std::string& path) const {
+  std::string bytes;
+  {
+    const MapStore::ReadAccess map = store_.Read();
+    bytes = EncodeMapFile(*map, camera_, vocabulary_ ? vocabulary_->Checksum() : 0);
+  }
+  WriteBytesAtomically(path, bytes);
+  return bytes.size();
 }
 
 int SlamSystem::global_ba_runs() const { return global_ba_runs_; }

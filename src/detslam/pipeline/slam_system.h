@@ -135,6 +135,9 @@ class SlamSystem {
   int global_ba_runs() const;
   int global_ba_stopped() const;
   LoopDetectionStats loop_detection_stats() const;
+  // Writes the map to a map file (map/map_file.h) with this run's camera, pyramid and vocabulary
+  // checksum, atomically; returns the file's size in bytes. Throws InputError on failure.
+  uint64_t SaveMap(const std::string& path) const;
   // The vocabulary file in use ("none" without place recognition).
   const std::string& vocabulary_path() const { return vocabulary_path_; }
 

@@ -72,6 +72,8 @@ class Vocabulary {
   // Reads and validates a file written by Save; throws InputError naming the file and the fault
   // (missing, truncated, corrupt, other version). Leaves *this unchanged on error.
   void Load(const std::string& path);
+  // FNV-1a 64 of the file Save writes (identifies the vocabulary, e.g. in a map file).
+  uint64_t Checksum() const;
 
   bool empty() const { return words_.empty(); }
   size_t size() const { return words_.size(); }  // number of words

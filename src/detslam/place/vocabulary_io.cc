@@ -5,10 +5,9 @@
 //   float64 idf, 32 bytes descriptor; then uint64 FNV-1a 64 over every byte before it.
 #include <cmath>
 #include <cstring>
-#include <fstream>
-#include <iterator>
 
 #include "detslam/core/atomic_file.h"
+#include "detslam/core/binary_io.h"
 #include "detslam/core/check.h"
 #include "detslam/place/vocabulary.h"
 
@@ -19,27 +18,6 @@ constexpr char kMagic[8] = {'D', 'S', 'L', 'M', 'V', 'O', 'C', '\0'};
 constexpr size_t kHeaderBytes = 8 + 5 * 4;
 constexpr size_t kNodeBytes = 4 + 1 + 4 + 8 + 32;
 constexpr size_t kChecksumBytes = 8;
-
-uint64_t Fnv1a64(const char* data, size_t size) {
-  uint64_t hash = 14695981039346656037ULL;
-  for (size_t i = 0; i < size; ++i) {
-    hash ^= static_cast<uint8_t>(data[i]);
-    hash *= 1099511628211ULL;
-  }
-  return hash;
-}
-
-void PutLE(std::string* out, uint64_t value, int bytes) {
-  for (int i = 0; i < bytes; ++i) out->push_back(static_cast<char>((value >> (8 * i)) & 0xFF));
-}
-
-uint64_t GetLE(const std::string& in, size_t offset, int bytes) {
-  uint64_t value = 0;
-  for (int i = 0; i < bytes; ++i) {
-    value |= static_cast<uint64_t>(static_cast<uint8_t>(in[offset + i])) << (8 * i);
-  }
-  return value;
-}
 
 std::string Encode(const Vocabulary& v) {
   std::string out(kMagic, sizeof(kMagic));
@@ -68,19 +46,16 @@ void Vocabulary::Save(const std::string& path) const {
   WriteBytesAtomically(path, Encode(*this));
 }
 
+uint64_t Vocabulary::Checksum() const {
+  const std::string bytes = Encode(*this);
+  return GetLE(bytes, bytes.size() - kChecksumBytes, 8);
+}
+
 void Vocabulary::Load(const std::string& path) {
   auto fail = [&path](const std::string& what) {
     throw InputError(path, 0, "vocabulary file: " + what);
   };
-  std::ifstream in(path, std::ios::binary);
-  if (!in) fail("cannot open");
-  in.seekg(0, std::ios::end);
-  const std::streamoff length = in.tellg();
-  in.seekg(0, std::ios::beg);
-  if (length < 0) fail("cannot read its length");
-  if (length > (std::streamoff(1) << 32)) fail("larger than 4 GiB, not a vocabulary");
-  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  if (in.bad()) fail("read error");
+  const std::string bytes = ReadFileBytes(path, uint64_t(1) << 32, "vocabulary file");
   if (bytes.size() < kHeaderBytes + kChecksumBytes) {
     fail("truncated (" + std::to_string(bytes.size()) + " bytes, a header needs " +
          std::to_string(kHeaderBytes + kChecksumBytes) + ")");
