@@ -209,8 +209,11 @@ PeopleScript::PeopleScript(const std::string& preset, uint64_t seed) {
     return;
   }
   if (preset == "loop") {
-    // One person strolling along the far side of the room.
-    walkers_.push_back({{0.0, 0.3}, {1, 0}, 1.6, 18.0, phase(), 0.15, 1.72, false});
+    // One person strolling along the far side of the room, behind the central desk (y 2.1; the
+    // desk spans y 0.6-1.9, the camera's circuit y -1.6..0.4, so they never meet: earlier the
+    // person walked at y 0.3, across the circuit, and on some seeds filled the view from a few
+    // centimetres, which no camera operator would let happen).
+    walkers_.push_back({{0.0, 2.1}, {1, 0}, 1.2, 18.0, phase(), 0.08, 1.72, false});
     return;
   }
   // Walking presets: two people crossing the view back and forth in front of the table
