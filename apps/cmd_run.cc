@@ -28,6 +28,8 @@ struct RunArgs {
   double max_dt = 0.02;
   bool no_progress = false;
   std::string save_map;
+  std::string load_map;
+  bool localization = false;
   bool threaded = false;
   bool inline_mapping = false;
   std::string segmenter;  // empty: dnn if the models are found, else none
@@ -77,6 +79,7 @@ void Run(const RunArgs& a) {
   options.out_dir = a.out;
   options.max_frames = a.max_frames;
   options.save_map = a.save_map;
+  options.load_map = a.load_map;
   options.threaded = a.threaded;
   options.slam = SlamOptionsFromSettings(settings, a.seed);
   options.mapping_thread = a.threaded && !a.inline_mapping;
@@ -86,6 +89,9 @@ void Run(const RunArgs& a) {
   if (a.no_geometric_check) options.slam.dynamic.geometric.enabled = false;
   if (a.segment_every > 0) options.slam.dynamic.segment_every = a.segment_every;
   if (!a.vocabulary.empty()) options.slam.vocabulary = a.vocabulary;
+  if (a.localization && a.load_map.empty())
+    throw InputError("--localization needs a map to localise in (--load-map FILE)");
+  options.slam.localization = a.localization;
   std::string error;
   if (!options.slam.Check(&error)) throw InputError(settings.source, 0, error);
   const std::string models_dir = a.models.empty() ? DefaultModelsDir() : a.models;
@@ -156,6 +162,10 @@ void AddRunCommand(CLI::App& app) {
   cmd->add_flag("--no-progress", args->no_progress, "No progress bar");
   cmd->add_option("--save-map", args->save_map,
                   "Write the final map to this map file (keyframes, map points, covisibility; `detslam map info FILE`)");
+  cmd->add_option("--load-map", args->load_map,
+                  "Start from the map in this map file (written by --save-map with the same camera, ORB settings and vocabulary): relocalise in it, then extend it");
+  cmd->add_flag("--localization", args->localization,
+                "With --load-map: track against the loaded map only (no new keyframes or map points)");
   cmd->callback([args] { Run(*args); });
 }
 

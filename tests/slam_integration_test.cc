@@ -201,7 +201,8 @@ TEST(IntegrationSlamSynthetic, StaticPresetTracksEveryFrameWithinOneCentimetre) 
 }
 
 // The map of a real run (culled keyframes, fused points, covisibility, spanning tree) survives
-// save -> load -> save byte for byte, and the loaded map is the run's.
+// save -> load -> save byte for byte, and the loaded map is the run's; a run in localisation mode
+// in it tracks the same sequence.
 TEST(IntegrationMapFile, ARunsMapSurvivesSaveLoadSave) {
   const std::string seq = WriteStaticSequence("map_file", 2, 120);
   const std::string out = TempDir("map_file_run");
@@ -228,6 +229,24 @@ TEST(IntegrationMapFile, ARunsMapSurvivesSaveLoadSave) {
             ReadFile(options.save_map));
   const nlohmann::json j = nlohmann::json::parse(ReadFile((fs::path(out) / "run.json").string()));
   EXPECT_EQ(j["map_file"]["bytes"].get<uint64_t>(), info.bytes);
+
+  // Localisation mode in the saved map, same sequence: every frame tracked, no keyframe added,
+  // ATE at most 1.1 x the SLAM run's.
+  const EvalResult slam_eval =
+      EvaluateFiles(dataset.groundtruth_path(), (fs::path(out) / "trajectory.txt").string(), seq, {});
+  RunOptions loc = options;
+  loc.out_dir = TempDir("map_file_localization");
+  loc.save_map.clear();
+  loc.load_map = options.save_map;
+  loc.slam.localization = true;
+  const RunSummary localized = detslam::Run(dataset, settings, loc, nullptr, nullptr);
+  EXPECT_EQ(localized.tracked, localized.frames);
+  EXPECT_EQ(localized.keyframes, summary.keyframes);
+  EXPECT_EQ(localized.loaded_keyframes, summary.keyframes);
+  const EvalResult loc_eval = EvaluateFiles(
+      dataset.groundtruth_path(), (fs::path(loc.out_dir) / "trajectory.txt").string(), seq, {});
+  EXPECT_LE(loc_eval.ate.error_m.rmse, 1.1 * slam_eval.ate.error_m.rmse)
+      << "localisation " << loc_eval.ate.error_m.rmse << " m, SLAM " << slam_eval.ate.error_m.rmse;
 }
 
 }  // namespace

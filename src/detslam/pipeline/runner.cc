@@ -89,6 +89,12 @@ void WriteOutputs(const RgbdDataset& dataset, const Settings& settings, const Ru
   j["global_ba"] = {{"runs", summary.global_ba_runs}, {"stopped", summary.global_ba_stopped}};
   if (!options.save_map.empty())
     j["map_file"] = {{"path", options.save_map}, {"bytes", summary.map_file_bytes}};
+  if (!options.load_map.empty()) {
+    j["loaded_map"] = {{"path", options.load_map},
+                       {"keyframes", summary.loaded_keyframes},
+                       {"map_points", summary.loaded_landmarks},
+                       {"localization", options.slam.localization}};
+  }
   j["vocabulary"] = slam.vocabulary_path();
   j["wall_s"] = summary.wall_s;
   j["segmenter"] = summary.segmenter.empty() ? "none" : summary.segmenter;
@@ -164,6 +170,14 @@ class RunRecorder {
                         r.timings.mapping_ms);
     summary_.reports.push_back(r);
     if (progress_) progress_(summary_.frames, total_, r);
+  }
+
+  // Starts `slam` from options.load_map (if any); recorded in the summary.
+  void LoadMap(const RunOptions& options, SlamSystem* slam) {
+    if (options.load_map.empty()) return;
+    const MapFileInfo info = slam->LoadMap(options.load_map);
+    summary_.loaded_keyframes = info.keyframes;
+    summary_.loaded_landmarks = info.landmarks;
   }
 
   RunSummary Finish(const RgbdDataset& dataset, const Settings& settings, const RunOptions& options,
@@ -251,6 +265,7 @@ RunSummary RunSequential(const RgbdDataset& dataset, const Settings& settings,
   SlamSystem slam(settings.camera, options.slam, segmenter);
   const size_t n = FrameCount(dataset, options);
   RunRecorder recorder(n, progress);
+  recorder.LoadMap(options, &slam);
   for (size_t i = 0; i < n; ++i) {
     const LoadedFrame loaded = LoadAndSegment(dataset, settings, i, &slam);
     FrameReport report;
@@ -271,6 +286,7 @@ RunSummary RunThreaded(const RgbdDataset& dataset, const Settings& settings,
   SlamSystem slam(settings.camera, slam_options, segmenter);
   const size_t n = FrameCount(dataset, options);
   RunRecorder recorder(n, progress);
+  recorder.LoadMap(options, &slam);
   struct Extracted {
     Frame frame;
     FrameReport report;

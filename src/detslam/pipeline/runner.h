@@ -22,6 +22,7 @@ struct RunOptions {
   bool mapping_thread = false;  // threaded: local mapping in its own thread (not deterministic)
   size_t queue_capacity = 4;    // frames buffered between the threaded stages
   std::string save_map;         // write the final map to this map file (empty: none)
+  std::string load_map;         // start from the map in this map file (empty: a new map)
   SlamOptions slam;
 };
 
@@ -40,6 +41,7 @@ struct RunSummary {
   int global_ba_runs = 0;     // global bundle adjustments started after loops
   int global_ba_stopped = 0;  // ... stopped early by a newer loop (solution discarded)
   uint64_t map_file_bytes = 0;  // size of the map file written (save_map)
+  uint64_t loaded_keyframes = 0, loaded_landmarks = 0;  // of the map loaded (load_map)
   std::vector<LoopRecord> loop_records;
   double wall_s = 0;
   ErrorStats segmentation, extraction, tracking, mapping, total;  // per-stage times, ms

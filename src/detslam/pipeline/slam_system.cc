@@ -137,6 +137,24 @@ std::vector<double> SlamSystem::mapping_times_ms() const {
   return mapping_times_ms_;
 }
 
+MapFileInfo SlamSystem::LoadMap(const std::string& path) {
+  MapFileExpectation expected;
+  expected.camera = camera_;
+  expected.scale = MakeScaleInfo(extractor_);
+  expected.vocabulary_checksum = vocabulary_ ? vocabulary_->Checksum() : 0;
+  MapFileInfo info;
+  Map loaded = LoadMapFile(path, expected, &info);
+  if (loaded.NumKeyFrames() == 0) throw InputError(path, 0, "map file: the map has no keyframes");
+  const MapStore::WriteAccess map = store_.Write();
+  DETSLAM_CHECK_MSG(map->NumKeyFrames() == 0 && tracked_.empty(),
+                    "LoadMap must come before the first frame");
+  *map = std::move(loaded);
+  tracker_.StartInLoadedMap();
+  spdlog::info("{}: loaded {} keyframes and {} map points; relocalising", path,
+               map->NumKeyFrames(), map->NumLandmarks());
+  return info;
+}
+
 uint64_t SlamSystem::SaveMap(const std::string& path) const {
   std::string bytes;
   {
@@ -225,7 +243,7 @@ KeyFrameId SlamSystem::TrackFrame(Frame frame, FrameReport* report) {
   const size_t kfs_before = map.NumKeyFrames();
   report->tracking = tracker_.Track(map, &frame);
   KeyFrameId new_kf = kNoKeyFrame;
-  if (report->tracking.pose_valid && report->tracking.need_keyframe)
+  if (report->tracking.pose_valid && report->tracking.need_keyframe && !options_.localization)
     new_kf = tracker_.CreateKeyFrame(map, &frame);
   if (map.NumKeyFrames() > kfs_before && new_kf == kNoKeyFrame)
     new_kf = tracker_.reference_keyframe();

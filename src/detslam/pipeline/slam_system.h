@@ -16,6 +16,7 @@
 #include "detslam/io/trajectory.h"
 #include "detslam/loop/loop_closer.h"
 #include "detslam/map/map.h"
+#include "detslam/map/map_file.h"
 #include "detslam/map/map_store.h"
 #include "detslam/mapping/local_mapper.h"
 #include "detslam/place/vocabulary.h"
@@ -38,6 +39,10 @@ struct SlamOptions {
   // nor local mapping waits for it (the threaded runner with a mapping thread sets this). A new
   // loop waits for the previous one's to finish.
   bool global_ba_thread = false;
+  // Localisation mode (with a loaded map, LoadMap): track against the map only; no keyframes, no
+  // map points, no local mapping or loop closing. Between relocalisations the tracker follows the
+  // camera on frame-to-frame points from depth (visual odometry).
+  bool localization = false;
   bool Check(std::string* error) const;
 };
 
@@ -135,6 +140,11 @@ class SlamSystem {
   int global_ba_runs() const;
   int global_ba_stopped() const;
   LoopDetectionStats loop_detection_stats() const;
+  // Starts from the map in a map file (before the first frame): the tracker relocalises in it
+  // from the first frame on; new keyframes extend it unless in localisation mode. Throws
+  // InputError naming the file when it is damaged or was made with another camera, ORB pyramid
+  // or vocabulary.
+  MapFileInfo LoadMap(const std::string& path);
   // Writes the map to a map file (map/map_file.h) with this run's camera, pyramid and vocabulary
   // checksum, atomically; returns the file's size in bytes. Throws InputError on failure.
   uint64_t SaveMap(const std::string& path) const;

@@ -86,6 +86,8 @@ class Tracker {
   // closing asks while a verified loop waits for more keyframes to agree, which on a revisit of
   // well-tracked ground would otherwise come seconds apart.
   void RequestKeyFrame() { keyframe_requested_ = true; }
+  // With a map loaded before the first frame: no initialisation, relocalise from the first frame.
+  void StartInLoadedMap() { state_ = TrackingState::kLost; }
 
  private:
   // ORB-SLAM3's fixed tracking thresholds (Tracking.cc, RGB-D), named.
