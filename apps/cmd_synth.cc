@@ -23,6 +23,9 @@ void AddSynthCommand(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--seed", opts->seed, "Seed of textures, people and sensor noise")
       ->capture_default_str();
+  cmd->add_option("--scene-seed", opts->scene_seed,
+                  "Seed of the scene's textures (default: --seed); the same scene seed with another "
+                  "--seed gives another camera path through the same room");
   cmd->add_option("--frames", opts->frames, "Number of frames (default: the preset's length)");
   cmd->add_option("--people", opts->people_dir,
                   "Folder of RGBA person cut-outs (*.png, alpha = silhouette) to texture people");
@@ -51,6 +54,7 @@ void AddSynthCommand(CLI::App& app) {
                          : nlohmann::json();
       nlohmann::json j = {{"preset", opts->preset},
                           {"seed", opts->seed},
+                          {"scene_seed", opts->SceneSeed()},
                           {"people", opts->people},
                           {"people_dir", opts->people_dir},
                           {"motion_blur", opts->motion_blur},

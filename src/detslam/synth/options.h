@@ -10,6 +10,10 @@ namespace detslam {
 struct SynthOptions {
   std::string preset = "walking_xyz";  // camera/people script, one of SynthPresetNames()
   uint64_t seed = 1;                   // seeds textures, people and sensor noise
+  // Seeds the scene's textures instead of `seed` when non-zero: two sequences with the same scene
+  // seed and different seeds are two camera paths (and people, noise) through the same room.
+  uint64_t scene_seed = 0;
+  uint64_t SceneSeed() const { return scene_seed != 0 ? scene_seed : seed; }
   int frames = -1;                     // number of frames; <= 0: the preset's default length
   std::string people_dir;              // folder with person_*.png RGBA cut-outs; empty: procedural
   bool people = true;                  // false: the static twin (same camera path, no people)

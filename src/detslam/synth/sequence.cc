@@ -45,7 +45,7 @@ SyntheticSequence::SyntheticSequence(const SynthOptions& options)
     : options_(Validated(options)),
       frames_(SynthFrameCount(options)),
       camera_(SynthCamera()),
-      scene_(synth::BuildSceneForPreset(options.preset, options.seed)),
+      scene_(synth::BuildSceneForPreset(options.preset, options.SceneSeed())),
       path_(options.preset, options.seed),
       people_(options.preset, options.seed) {
   if (!options_.people_dir.empty()) {
