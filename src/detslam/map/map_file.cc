@@ -131,7 +131,7 @@ bool SameCamera(const PinholeCamera& a, const PinholeCamera& b) {
          near(a.p1, b.p1) && near(a.p2, b.p2) && near(a.k3, b.k3) && near(a.bf, b.bf);
 }
 
-KeyFrame GetKeyFrame(ByteReader* r, const MapFileExpectation& expected, int levels) {
+KeyFrame GetKeyFrame(ByteReader* r, const PinholeCamera& camera, int levels) {
   KeyFrame kf;
   kf.id = r->I64("keyframe id");
   const std::string where = "keyframe " + std::to_string(kf.id);
@@ -207,7 +207,7 @@ KeyFrame GetKeyFrame(ByteReader* r, const MapFileExpectation& expected, int leve
     if (!kf.covisibility.emplace(other, weight).second)
       r->Fail(where + ": covisible keyframe " + std::to_string(other) + " repeated");
   }
-  f->grid = std::make_shared<KeypointGrid>(f->undist, octaves, UndistortedBounds(expected.camera));
+  f->grid = std::make_shared<KeypointGrid>(f->undist, octaves, UndistortedBounds(camera));
   kf.features = std::move(f);
   return kf;
 }
@@ -326,10 +326,8 @@ namespace {
 
 // Parses the keyframes and map points after the header; grids from `camera`.
 Map ParseBody(ByteReader* r, Header* h, const PinholeCamera& camera) {
-  MapFileExpectation grid_camera;
-  grid_camera.camera = camera;
   std::vector<KeyFrame> keyframes(r->Count("keyframe count", kKeyFrameMinBytes));
-  for (KeyFrame& kf : keyframes) kf = GetKeyFrame(r, grid_camera, h->info.levels);
+  for (KeyFrame& kf : keyframes) kf = GetKeyFrame(r, camera, h->info.levels);
   std::vector<Landmark> landmarks(r->Count("map point count", kLandmarkMinBytes));
   for (Landmark& lm : landmarks) lm = GetLandmark(r);
   if (r->remaining() != kChecksumBytes) {
