@@ -17,6 +17,7 @@ void AddSynthCommand(CLI::App& app) {
   auto stats_json = std::make_shared<std::string>();
   auto no_people = std::make_shared<bool>(false);
   auto cut = std::make_shared<std::string>();
+  auto cover = std::make_shared<std::string>();
   std::string presets;
   for (const auto& p : SynthPresetNames()) presets += (presets.empty() ? "" : ", ") + p;
   cmd->add_option("--preset", opts->preset, "Camera/people script: " + presets)
@@ -38,12 +39,17 @@ void AddSynthCommand(CLI::App& app) {
   cmd->add_option("--cut", *cut,
                   "A:B drops frames A..B-1 from the written sequence (the camera keeps moving: "
                   "frame A-1 is followed by frame B, a kidnapped camera)");
+  cmd->add_option("--cover", *cover,
+                  "START:SECONDS covers the lens from START for SECONDS: black colour images and "
+                  "no depth while the camera keeps moving (e.g. 8:2 on the roam preset hides its "
+                  "turn towards the unseen back of the room)");
   cmd->add_option("--out", *out_dir, "Output folder")->required();
   cmd->add_option("--stats-json", *stats_json,
                   "Write timing and content statistics (fps, FAST corners, coverage) as JSON");
-  cmd->callback([opts, out_dir, stats_json, no_people, cut] {
+  cmd->callback([opts, out_dir, stats_json, no_people, cut, cover] {
     opts->people = !*no_people;
     if (!cut->empty()) ParseSynthCut(*cut, opts.get());
+    if (!cover->empty()) ParseSynthCover(*cover, opts.get());
     RequireSynthPreset(opts->preset);
     std::string error;
     if (!opts->Check(&error)) throw InputError("detslam synth: " + error);
@@ -60,6 +66,10 @@ void AddSynthCommand(CLI::App& app) {
                           {"motion_blur", opts->motion_blur},
                           {"depth_scale_bias", opts->depth_scale_bias},
                           {"cut", cut_frames},
+                          {"cover", opts->HasCover() ? nlohmann::json::array(
+                                                           {opts->cover_start_s,
+                                                            opts->cover_seconds})
+                                                     : nlohmann::json()},
                           {"frames", s.frames},
                           {"render_seconds", s.render_seconds},
                           {"total_seconds", s.total_seconds},

@@ -97,6 +97,10 @@ void LoopCloser::Close(Map& map, KeyFrameId kf_id, const Verified& loop,
   result->candidate = loop.candidate;
   result->inliers = loop.inliers;
   result->agreeing = std::max(1, loop.coincidences);
+  if (map.MapOf(loop.candidate) != map.MapOf(kf_id)) {
+    Merge(map, kf_id, loop, result);
+    return;
+  }
   // A revisit that the map already agrees with (the place seen again with no drift to speak of):
   // the duplicated landmarks are fused, but there is nothing to correct.
   const double moved_m = (loop.cam_from_world.Inverse().translation() -
@@ -125,6 +129,35 @@ void LoopCloser::Close(Map& map, KeyFrameId kf_id, const Verified& loop,
       result->correction_m);
 }
 
+void LoopCloser::Merge(Map& map, KeyFrameId kf_id, Verified loop, LoopClosingResult* result) {
+  const int kf_map = map.MapOf(kf_id), candidate_map = map.MapOf(loop.candidate);
+  // The map whose root is older keeps its frame (so the map of the first frame never moves);
+  // loop.correction is world_candidate_from_world_kf.
+  const bool move_current = map.map_roots().at(kf_map) > map.map_roots().at(candidate_map);
+  const int from = move_current ? kf_map : candidate_map;
+  const int into = move_current ? candidate_map : kf_map;
+  std::map<KeyFrameId, Rigid3d> before =
+      move_current ? map.MergeMapInto(from, into, loop.correction, kf_id, loop.candidate)
+                   : map.MergeMapInto(from, into, loop.correction.Inverse(), loop.candidate,
+                                      kf_id);
+  // The verified pose of the keyframe, in the merged map's frame: now close to its own pose.
+  if (!move_current) loop.cam_from_world = loop.cam_from_world * loop.correction;
+  loop.correction = loop.cam_from_world.Inverse() * map.keyframe(kf_id).cam_from_world;
+  Correct(map, kf_id, loop, /*correct_poses=*/true, result);
+  // The tracker moves its last frame from the poses before the whole step.
+  for (const auto& [id, pose] : before) result->old_poses[id] = pose;
+  result->closed = true;
+  result->merged = true;
+  result->merged_from = from;
+  result->merged_into = into;
+  ++maps_merged_;
+  spdlog::info(
+      "maps merged: map {} into map {} at keyframe {} with keyframe {} ({} inliers, {} keyframes "
+      "agree, {} landmarks fused, seam correction {:.3f} m)",
+      from, into, kf_id, loop.candidate, loop.inliers, loop.coincidences, result->fused,
+      result->correction_m);
+}
+
 bool LoopCloser::WithinRadius(const Map& map, KeyFrameId kf_id, KeyFrameId other) const {
   return (map.keyframe(other).Center() - map.keyframe(kf_id).Center()).norm() <
          options_.candidate_radius_m;
@@ -138,7 +171,7 @@ std::vector<KeyFrameId> LoopCloser::CandidatesByPosition(const Map& map, KeyFram
   std::vector<std::pair<double, KeyFrameId>> near;
   for (const auto& [id, other] : map.keyframes()) {
     if (id > kf_id - options_.min_keyframe_gap) break;  // ids ascend
-    if (kf.covisibility.count(id)) continue;
+    if (kf.covisibility.count(id) || other.map_id != kf.map_id) continue;
     const double d = (other.Center() - center).norm();
     if (d < options_.candidate_radius_m) near.emplace_back(d, id);
   }
@@ -154,16 +187,19 @@ std::vector<KeyFrameId> LoopCloser::CandidatesByPosition(const Map& map, KeyFram
 
 std::vector<KeyFrameId> LoopCloser::CandidatesByAppearance(const Map& map,
                                                            KeyFrameId kf_id) const {
+  const int own_map = map.MapOf(kf_id);
   std::set<KeyFrameId> recent;
   for (auto it = map.keyframes().rbegin(); it != map.keyframes().rend(); ++it) {
     if (it->first <= kf_id - options_.min_keyframe_gap) break;
-    recent.insert(it->first);
+    if (it->second.map_id == own_map) recent.insert(it->first);
   }
   std::vector<PlaceCandidate> found = LoopCandidates(map, kf_id, recent);
   if (options_.candidate_radius_m > 0) {
-    found.erase(std::remove_if(
-                    found.begin(), found.end(),
-                    [&](const PlaceCandidate& c) { return !WithinRadius(map, kf_id, c.keyframe); }),
+    found.erase(std::remove_if(found.begin(), found.end(),
+                               [&](const PlaceCandidate& c) {
+                                 return map.MapOf(c.keyframe) == own_map &&
+                                        !WithinRadius(map, kf_id, c.keyframe);
+                               }),
                 found.end());
   }
   std::vector<KeyFrameId> out;
@@ -394,13 +430,14 @@ void LoopCloser::Correct(Map& map, KeyFrameId kf_id, const Verified& loop, bool 
   // Essential graph: spanning tree, strong covisibility, and the new loop connections.
   PoseGraphProblem problem;
   std::map<KeyFrameId, size_t> node;
+  const int own_map = map.MapOf(kf_id);
   for (const auto& [id, k] : map.keyframes()) {
-    (void)k;
+    if (k.map_id != own_map) continue;  // other maps of the atlas are not connected to this one
     node[id] = problem.nodes.size();
     PoseGraphProblem::Node n;
     n.id = id;
     n.cam_from_world = initial.at(id);
-    n.fixed = id == map.first_keyframe();
+    n.fixed = map.IsMapRoot(id);
     problem.nodes.push_back(n);
   }
   std::set<std::pair<KeyFrameId, KeyFrameId>> added;

@@ -7,6 +7,10 @@
 // adjustment of the whole map that follows (global_ba_iterations) is the caller's step, outside
 // the map lock (mapping/map_bundle.h GlobalBundleAdjustment).
 //
+// Several maps (Map is the atlas): a candidate in another map is a merge (Merge). The position
+// gate and the recent-keyframe exclusion apply within the keyframe's own map only (another map's
+// positions are in another frame); merges need a vocabulary.
+//
 // Candidates: with a vocabulary (keyframes carry bag-of-words vectors), by appearance among the
 // keyframes that are neither covisible with the new one nor among its `min_keyframe_gap` newest
 // (place_candidates.h), the best `appearance_candidates` groups; `candidate_radius_m` > 0 adds a
@@ -67,6 +71,11 @@ struct LoopClosingResult {
   int agreeing = 0;  // keyframes that agreed on it (appearance; 1 for a loop found by position)
   int fused = 0;                       // landmarks merged
   double correction_m = 0;             // how far the keyframe moved
+  // The candidate lay in another map of the atlas: the two maps were merged (map `merged_from`
+  // moved into map `merged_into`'s frame; the one whose root is older keeps its frame), then
+  // welded like a loop (fusion, pose graph over the merged map). `closed` is set too.
+  bool merged = false;
+  int merged_from = -1, merged_into = -1;
   // Keyframe poses before the correction (cam_from_world), for the tracker and the trajectory.
   std::map<KeyFrameId, Rigid3d> old_poses;
 };
@@ -91,7 +100,8 @@ class LoopCloser {
   // access for the whole step). Deterministic.
   LoopClosingResult Process(Map& map, KeyFrameId kf);
 
-  int loops_closed() const { return loops_closed_; }
+  int loops_closed() const { return loops_closed_; }  // merges not included
+  int maps_merged() const { return maps_merged_; }
   const LoopDetectionStats& stats() const { return stats_; }
   // A loop verified but not yet agreed on by enough keyframes: the next keyframes decide.
   bool has_pending() const { return pending_.has_value(); }
@@ -129,6 +139,9 @@ class LoopCloser {
   // pending loop is re-verified at kf).
   bool ConfirmPending(const Map& map, KeyFrameId kf);
   void Close(Map& map, KeyFrameId kf, const Verified& loop, LoopClosingResult* result);
+  // A verified candidate in another map: moves the map whose root is newer into the other's frame
+  // (Map::MergeMapInto), then Correct welds the seam.
+  void Merge(Map& map, KeyFrameId kf, Verified loop, LoopClosingResult* result);
   // Fuses the loop side's landmarks into kf's neighbourhood and, with correct_poses, moves the map
   // (pose graph, landmarks with their reference keyframes).
   void Correct(Map& map, KeyFrameId kf, const Verified& loop, bool correct_poses,
@@ -140,6 +153,7 @@ class LoopCloser {
   std::optional<Verified> pending_;  // appearance: verified but not yet agreed on
   KeyFrameId last_loop_kf_ = kNoKeyFrame;
   int loops_closed_ = 0;
+  int maps_merged_ = 0;
   LoopDetectionStats stats_;
 };
 

@@ -20,6 +20,8 @@ Map::Map(const Map& other)
       keyframes_(other.keyframes_),
       landmarks_(other.landmarks_),
       place_index_(other.place_index_),
+      roots_(other.roots_),
+      next_map_id_(other.next_map_id_),
       next_keyframe_id_(other.next_keyframe_id_),
       next_landmark_id_(other.next_landmark_id_) {
   RebuildIndex();
@@ -90,11 +92,30 @@ Map Map::Restore(ScaleInfo scale, std::vector<KeyFrame> keyframes, std::vector<L
              " has no matching reverse edge");
       }
     }
+    if (kf.map_id < 0) fail(where + "negative map id");
+    if (!map.roots_.count(kf.map_id)) map.roots_[kf.map_id] = id;  // ascending: the lowest id
+    map.next_map_id_ = std::max(map.next_map_id_, kf.map_id + 1);
+    for (const auto& [other, weight] : kf.covisibility) {
+      (void)weight;
+      if (map.keyframes_.at(other).map_id != kf.map_id)
+        fail(where + "covisibility with keyframe " + std::to_string(other) + " of another map");
+    }
     if (kf.parent != kNoKeyFrame) {
       auto it = map.keyframes_.find(kf.parent);
       if (kf.parent == id || it == map.keyframes_.end())
         fail(where + "parent " + std::to_string(kf.parent) + " does not exist");
+      if (it->second.map_id != kf.map_id)
+        fail(where + "parent " + std::to_string(kf.parent) + " lies in another map");
+      if (map.roots_.at(kf.map_id) == id) fail(where + "the first keyframe of a map has a parent");
       it->second.children.insert(id);
+    }
+  }
+  for (const auto& [id, lm] : map.landmarks_) {
+    for (const auto& [kf_id, idx] : lm.observations) {
+      (void)idx;
+      if (map.keyframes_.at(kf_id).map_id !=
+          map.keyframes_.at(lm.observations.begin()->first).map_id)
+        fail("map point " + std::to_string(id) + ": observed from two maps");
     }
   }
   map.RebuildIndex();
@@ -105,6 +126,12 @@ KeyFrameId Map::AddKeyFrame(KeyFrame kf) {
   kf.id = next_keyframe_id_++;
   kf.landmarks.assign(kf.features->size(), kNoLandmark);
   const KeyFrameId id = kf.id;
+  DETSLAM_CHECK(kf.map_id >= 0);
+  if (!roots_.count(kf.map_id)) {
+    DETSLAM_CHECK_MSG(kf.map_id >= next_map_id_, "map " << kf.map_id << " no longer exists");
+    roots_[kf.map_id] = id;
+    next_map_id_ = kf.map_id + 1;
+  }
   if (!kf.features->bow.empty()) place_index_.Insert(id, kf.features->bow);
   KeyFrame* stored = &keyframes_.emplace(id, std::move(kf)).first->second;
   keyframe_at_.resize(static_cast<size_t>(next_keyframe_id_), nullptr);
@@ -198,7 +225,7 @@ void Map::ReplaceLandmark(LandmarkId from, LandmarkId into) {
 }
 
 void Map::EraseKeyFrame(KeyFrameId kf_id) {
-  if (!HasKeyFrame(kf_id) || kf_id == first_keyframe()) return;
+  if (!HasKeyFrame(kf_id) || IsMapRoot(kf_id)) return;
   KeyFrame& kf = keyframe(kf_id);
   const std::vector<LandmarkId> lms = kf.landmarks;
   for (LandmarkId lm : lms) {
@@ -242,7 +269,7 @@ void Map::UpdateConnections(KeyFrameId kf_id) {
     keyframe(other).covisibility[kf_id] = w;
     if (w > best_w) best_w = w, best = other;
   }
-  if (kf.parent == kNoKeyFrame && best != kNoKeyFrame && kf_id != first_keyframe()) {
+  if (kf.parent == kNoKeyFrame && best != kNoKeyFrame && !IsMapRoot(kf_id)) {
     kf.parent = best;
     keyframe(best).children.insert(kf_id);
   }

@@ -1,6 +1,13 @@
 // The data-only map: keyframes and landmarks owned by id, observations and covisibility by id.
 // The Map guards its own invariants: an observation exists in the landmark and in the keyframe's
 // slot at the same time, covisibility weights equal the number of shared landmarks.
+//
+// The Map is also the atlas (ORB-SLAM3's several maps): every keyframe carries a map id, and maps
+// never share a landmark or a covisibility edge, so each one has its own world frame. A new map
+// starts when tracking is lost (its first keyframe, the map's root, fixes its gauge: never culled,
+// no parent, fixed in every optimisation); MergeMapInto moves one map into another's frame once
+// place recognition has found and verified their overlap. Place recognition (place_index) spans
+// all maps.
 #pragma once
 
 #include <Eigen/Core>
@@ -17,6 +24,7 @@ namespace detslam {
 
 struct KeyFrame {
   KeyFrameId id = kNoKeyFrame;
+  int map_id = 0;           // the map of the atlas it belongs to (see Map)
   int64_t frame_index = 0;  // input frame it was made from
   Timestamp stamp;
   Rigid3d cam_from_world;
@@ -62,9 +70,10 @@ class Map {
   // A map rebuilt from stored parts (map files): keyframes and landmarks keep their ids (ascending,
   // below next_keyframe_id / next_landmark_id); keyframe slots are filled from the landmarks'
   // observations, children from the parents; keyframes with a bag-of-words vector enter the place
-  // index. Throws InputError(message) when the parts break an invariant (an observation of a
-  // missing keyframe or slot, a slot taken twice, a covisibility edge without its reverse, a
-  // parent that does not exist).
+  // index; each map's root is its lowest keyframe id. Throws InputError(message) when the parts
+  // break an invariant (an observation of a missing keyframe or slot, a slot taken twice, a
+  // covisibility edge without its reverse or across maps, a landmark seen from two maps, a parent
+  // that does not exist or lies in another map, a map root with a parent).
   static Map Restore(ScaleInfo scale, std::vector<KeyFrame> keyframes,
                      std::vector<Landmark> landmarks, KeyFrameId next_keyframe_id,
                      LandmarkId next_landmark_id);
@@ -72,19 +81,22 @@ class Map {
   LandmarkId next_landmark_id() const { return next_landmark_id_; }
 
   // Assigns the id; landmarks vector must be all kNoLandmark. A keyframe whose features have a
-  // bag-of-words vector enters the place index.
+  // bag-of-words vector enters the place index. The first keyframe of a map id (kf.map_id) is
+  // that map's root.
   KeyFrameId AddKeyFrame(KeyFrame kf);
   LandmarkId AddLandmark(const Eigen::Vector3d& position, KeyFrameId reference);
   // Links landmark `lm` to keypoint `idx` of keyframe `kf` (both must exist, slot must be free).
   void AddObservation(LandmarkId lm, KeyFrameId kf, size_t idx);
   void EraseObservation(LandmarkId lm, KeyFrameId kf);
   void EraseLandmark(LandmarkId lm);
-  void EraseKeyFrame(KeyFrameId kf);  // reparents children, removes observations and index entry
+  // Reparents children, removes observations and index entry; a map root is never erased.
+  void EraseKeyFrame(KeyFrameId kf);
   // Merges `from` into `into` (all observations move; duplicates in one keyframe are dropped).
   void ReplaceLandmark(LandmarkId from, LandmarkId into);
 
   // Recomputes covisibility edges of `kf` (and the reciprocal ones) from shared landmarks and
-  // sets its parent to the neighbour with most shared points if it has none.
+  // sets its parent to the neighbour with most shared points if it has none (a map root never
+  // gets one).
   void UpdateConnections(KeyFrameId kf);
   // Recomputes normal, distance bounds and representative descriptor of a landmark.
   void UpdateLandmarkGeometry(LandmarkId lm);
@@ -108,6 +120,22 @@ class Map {
   KeyFrameId first_keyframe() const {
     return keyframes_.empty() ? kNoKeyFrame : keyframes_.begin()->first;
   }
+
+  // --- The atlas: several maps in one container ---
+  // An id for a map that has no keyframe yet (ids are never reused).
+  int NewMapId() const { return next_map_id_; }
+  // Root (first keyframe) of every map that exists, by map id.
+  const std::map<int, KeyFrameId>& map_roots() const { return roots_; }
+  bool IsMapRoot(KeyFrameId kf) const;
+  int MapOf(KeyFrameId kf) const { return keyframe(kf).map_id; }
+  // Keyframes of one map, ascending.
+  std::vector<KeyFrameId> KeyFramesOfMap(int map_id) const;
+  // Moves map `from` into map `into`: every keyframe and landmark of `from` is transformed by
+  // `into_from_from` (world_into_from_world_from) and relabelled, its spanning tree is re-rooted
+  // at `seam` (a keyframe of `from`) and hung below `into_seam` (a keyframe of `into`). Returns
+  // the poses (cam_from_world) of the moved keyframes before the move.
+  std::map<KeyFrameId, Rigid3d> MergeMapInto(int from, int into, const Rigid3d& into_from_from,
+                                             KeyFrameId seam, KeyFrameId into_seam);
   // Number of landmarks of `kf` observed by at least `min_obs` keyframes.
   int TrackedLandmarks(KeyFrameId kf, int min_obs) const;
 
@@ -133,6 +161,8 @@ class Map {
   std::vector<KeyFrame*> keyframe_at_;  // id -> element of keyframes_ (null: erased)
   std::vector<Landmark*> landmark_at_;  // id -> element of landmarks_ (null: erased)
   KeyFrameDatabase place_index_;
+  std::map<int, KeyFrameId> roots_;  // map id -> its first keyframe
+  int next_map_id_ = 0;
   KeyFrameId next_keyframe_id_ = 0;
   LandmarkId next_landmark_id_ = 0;
 };

@@ -1,9 +1,11 @@
-// Map file format (version 1), little-endian, every count a uint64:
+// Map file format (version 2: version 1 plus the map id of every keyframe, for the atlas's several
+// maps), little-endian, every count a uint64:
 //   "DSLMMAP\0", uint32 version;
 //   camera: int32 width, height; float64 fx, fy, cx, cy, k1, k2, p1, p2, k3, bf;
 //   pyramid: float64 scale factor, int32 levels; uint64 vocabulary checksum (0: none);
 //   int64 next keyframe id, next map point id;
 //   count, then per keyframe (ascending id): int64 id, frame index, stamp (ns), parent (-1: none);
+//     int32 map id;
 //     pose cam_from_world: float64 qw, qx, qy, qz, tx, ty, tz;
 //     count, then per keypoint: float32 x, y, size, angle, response; int32 octave, class id;
 //       float64 undistorted x, y; float32 depth, u_right; 32 descriptor bytes;
@@ -34,7 +36,7 @@ constexpr size_t kDescriptorBytes = 32;
 constexpr uint64_t kMaxFileBytes = uint64_t(16) << 30;
 // Smallest encodings, to check counts against what is left of the file.
 constexpr size_t kKeypointBytes = 5 * 4 + 2 * 4 + 2 * 8 + 2 * 4 + kDescriptorBytes;
-constexpr size_t kKeyFrameMinBytes = 4 * 8 + 7 * 8 + 8 + 1 + 8 + 8 + 8;
+constexpr size_t kKeyFrameMinBytes = 4 * 8 + 4 + 7 * 8 + 8 + 1 + 8 + 8 + 8;
 constexpr size_t kLandmarkMinBytes = 8 + 3 * 8 + 1 + 5 * 8 + 2 * 8 + 2 * 4 + 8;
 
 double ScaleFactorOf(const ScaleInfo& scale) {
@@ -138,6 +140,7 @@ KeyFrame GetKeyFrame(ByteReader* r, const PinholeCamera& camera, int levels) {
   kf.frame_index = r->I64("frame index");
   kf.stamp = Timestamp{r->I64("stamp")};
   kf.parent = r->I64("parent");
+  kf.map_id = r->I32("map id");
   kf.cam_from_world = GetPose(r, where);
   auto f = std::make_shared<FrameFeatures>();
   const uint64_t n = r->Count("keypoint count", kKeypointBytes);
@@ -261,6 +264,7 @@ std::string EncodeMapFile(const Map& map, const PinholeCamera& camera,
     w.I64(kf.frame_index);
     w.I64(kf.stamp.ns);
     w.I64(kf.parent);
+    w.I32(kf.map_id);
     PutPose(&w, kf.cam_from_world);
     const FrameFeatures& f = *kf.features;
     w.U64(f.size());

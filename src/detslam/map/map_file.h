@@ -1,4 +1,4 @@
-// Map files: a whole map (keyframes with keypoints, descriptors and bag-of-words data, map points,
+// Map files: the whole atlas (every map: keyframes with keypoints, descriptors and bag-of-words data, map points,
 // covisibility and spanning tree) with the camera, the scale pyramid and the vocabulary it was
 // made with, in a versioned little-endian binary format closed by a checksum (format in
 // map_file.cc). Written atomically; a file that is truncated, corrupt, of another version, or made
@@ -14,7 +14,7 @@
 
 namespace detslam {
 
-constexpr uint32_t kMapFileVersion = 1;
+constexpr uint32_t kMapFileVersion = 2;
 
 // What a map file holds besides the map (its header).
 struct MapFileInfo {

@@ -135,6 +135,25 @@ TEST(MapFile, RoundTripRestoresEveryFieldAndReencodesByteForByte) {
   EXPECT_EQ(loaded.place_index().Query(map.keyframe(2).features->bow, 1).at(0).id, 2);
 }
 
+TEST(MapFile, KeepsEveryMapOfTheAtlas) {
+  Fixture fx;
+  Map map = MakeMap(fx.camera);
+  KeyFrame second = map.keyframe(2);  // a copy, as the first keyframe of a second map
+  second.map_id = map.NewMapId();
+  second.parent = kNoKeyFrame;
+  second.children.clear();
+  second.covisibility.clear();
+  const KeyFrameId root = map.AddKeyFrame(second);
+  const std::string path = TempPath("atlas.dslmap");
+  SaveMapFile(path, map, fx.camera, 0x1234);
+  const Map loaded = LoadMapFile(path, fx.expected, nullptr);
+  EXPECT_EQ(loaded.map_roots(), map.map_roots());
+  EXPECT_EQ(loaded.MapOf(root), 1);
+  EXPECT_TRUE(loaded.IsMapRoot(root));
+  EXPECT_EQ(loaded.NewMapId(), 2);
+  EXPECT_EQ(EncodeMapFile(loaded, fx.camera, 0x1234), ReadAll(path));
+}
+
 // Every damaged variant of a valid file gives an InputError naming the file.
 void ExpectRefused(const std::string& path, const MapFileExpectation& expected,
                    const std::string& needle) {
@@ -169,10 +188,10 @@ TEST(MapFile, TruncatedCorruptOtherVersionAndMismatchesAreRefused) {
 
   // Another version with a valid checksum.
   std::string other_version = good.substr(0, good.size() - 8);
-  other_version[8] = 2;
+  other_version[8] = 3;
   PutLE(&other_version, Fnv1a64(other_version.data(), other_version.size()), 8);
   WriteAll(path, other_version);
-  ExpectRefused(path, fx.expected, "format version 2");
+  ExpectRefused(path, fx.expected, "format version 3");
 
   WriteAll(path, good);
   MapFileExpectation other = fx.expected;

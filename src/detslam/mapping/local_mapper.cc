@@ -171,9 +171,8 @@ void LocalMapper::LocalBundleAdjustment(MapStore* store, KeyFrameId current,
 }
 
 void LocalMapper::CullKeyFrames(Map& map, KeyFrameId current, LocalMappingSummary* summary) {
-  const KeyFrameId origin = map.first_keyframe();
   for (KeyFrameId k : map.BestCovisibles(current, 1000)) {
-    if (k == origin || k == current || !map.HasKeyFrame(k)) continue;
+    if (map.IsMapRoot(k) || k == current || !map.HasKeyFrame(k)) continue;
     const KeyFrame& kf = map.keyframe(k);
     int total = 0, redundant = 0;
     for (size_t i = 0; i < kf.size(); ++i) {

@@ -9,12 +9,11 @@ namespace detslam {
 MapBundle BuildMapBundle(const Map& map, const std::vector<KeyFrameId>& free,
                          const std::vector<KeyFrameId>& fixed) {
   MapBundle b;
-  const KeyFrameId origin = map.first_keyframe();
   std::map<KeyFrameId, size_t> pose_index;
   auto add_pose = [&](KeyFrameId k, bool is_fixed) {
     if (pose_index.count(k)) return;
     pose_index[k] = b.problem.poses.size();
-    b.problem.poses.push_back({k, map.keyframe(k).cam_from_world, is_fixed || k == origin});
+    b.problem.poses.push_back({k, map.keyframe(k).cam_from_world, is_fixed || map.IsMapRoot(k)});
   };
   for (KeyFrameId k : free) add_pose(k, false);
   for (KeyFrameId k : fixed) add_pose(k, true);
@@ -71,7 +70,10 @@ void PropagateBundleCorrection(const MapBundle& bundle, const std::map<KeyFrameI
   std::set<KeyFrameId> solved;
   for (const auto& p : bundle.problem.poses) solved.insert(p.id);
   std::vector<KeyFrameId> queue;
-  if (map->HasKeyFrame(map->first_keyframe())) queue.push_back(map->first_keyframe());
+  for (const auto& [map_id, root] : map->map_roots()) {  // every map's tree, from its root
+    (void)map_id;
+    queue.push_back(root);
+  }
   std::set<KeyFrameId> visited(queue.begin(), queue.end());
   for (size_t q = 0; q < queue.size(); ++q) {
     const KeyFrameId parent = queue[q];

@@ -30,7 +30,33 @@ void WriteOutputs(const RgbdDataset& dataset, const Settings& settings, const Ru
   const fs::path out(options.out_dir);
   const std::string header = "detslam trajectory (world_from_camera) of " + dataset.dir() +
                              "\nsettings: " + settings.source;
-  WriteTumTrajectory((out / "trajectory.txt").string(), slam.FrameTrajectory(), header);
+  // The main map's frames go to trajectory.txt; maps that never merged into it to files of their
+  // own (never mixed in). Those of an earlier run in the same folder are removed first.
+  const MapTrajectories trajectories = slam.FrameTrajectories();
+  std::error_code ec;
+  for (const auto& entry : fs::directory_iterator(out, ec)) {
+    const std::string name = entry.path().filename().string();
+    if (name.rfind("trajectory_map", 0) == 0 && entry.path().extension() == ".txt")
+      fs::remove(entry.path(), ec);
+  }
+  std::map<double, int> final_map;  // stamp -> map that holds the frame at the end
+  summary.tracked_main = 0;
+  for (const auto& [map_id, trajectory] : trajectories.by_map) {
+    for (const auto& p : trajectory) final_map[p.stamp.Seconds()] = map_id;
+    if (map_id == trajectories.main_map) {
+      summary.tracked_main = trajectory.size();
+      continue;
+    }
+    WriteTumTrajectory((out / ("trajectory_map" + std::to_string(map_id) + ".txt")).string(),
+                       trajectory,
+                       header + "\nmap " + std::to_string(map_id) +
+                           " of the atlas (never merged into the main map: its own frame)");
+  }
+  summary.maps_left = static_cast<int>(trajectories.by_map.size());
+  WriteTumTrajectory((out / "trajectory.txt").string(),
+                     trajectories.main_map < 0 ? Trajectory()
+                                               : trajectories.by_map.at(trajectories.main_map),
+                     header);
   WriteTumTrajectory((out / "keyframes.txt").string(), slam.KeyFrameTrajectory(),
                      "detslam keyframes of " + dataset.dir());
   std::vector<Eigen::Vector3d> points;
@@ -66,6 +92,32 @@ void WriteOutputs(const RgbdDataset& dataset, const Settings& settings, const Ru
   j["keyframes"] = summary.keyframes;
   j["map_points"] = summary.landmarks;
   j["relocalizations"] = summary.relocalizations;
+  j["frames_in_main_map"] = summary.tracked_main;
+  nlohmann::json lost = nlohmann::json::array();  // stretches of frames without a pose
+  for (size_t i = 0; i < summary.reports.size(); ++i) {
+    if (summary.reports[i].tracking.pose_valid) continue;
+    size_t k = i;
+    while (k + 1 < summary.reports.size() && !summary.reports[k + 1].tracking.pose_valid) ++k;
+    lost.push_back({{"first_frame", summary.reports[i].index},
+                    {"last_frame", summary.reports[k].index},
+                    {"frames", k - i + 1}});
+    i = k;
+  }
+  nlohmann::json merges = nlohmann::json::array();
+  for (const LoopRecord& r : summary.loop_records) {
+    if (r.merge)
+      merges.push_back({{"frame", r.frame}, {"from", r.merged_from}, {"into", r.merged_into}});
+  }
+  nlohmann::json frames_by_map = nlohmann::json::object();
+  for (const auto& [map_id, trajectory] : trajectories.by_map)
+    frames_by_map[std::to_string(map_id)] = trajectory.size();
+  j["maps"] = {{"main", trajectories.main_map},
+               {"started", summary.maps_started},
+               {"merged", summary.maps_merged},
+               {"left", summary.maps_left},
+               {"frames_by_map", frames_by_map},
+               {"merges", merges},
+               {"lost_stretches", lost}};
   j["loops_closed"] = summary.loops;
   nlohmann::json loops = nlohmann::json::array();
   for (const LoopRecord& r : summary.loop_records) {  // also those of a mapping thread
@@ -75,7 +127,8 @@ void WriteOutputs(const RgbdDataset& dataset, const Settings& settings, const Ru
                      {"candidate_frame", r.candidate_frame},
                      {"inliers", r.inliers},
                      {"agreeing_keyframes", r.agreeing},
-                     {"correction_m", r.correction_m}});
+                     {"correction_m", r.correction_m},
+                     {"merge", r.merge}});
   }
   j["loops"] = loops;
   const LoopDetectionStats& ld = summary.loop_detection;
@@ -93,6 +146,7 @@ void WriteOutputs(const RgbdDataset& dataset, const Settings& settings, const Ru
     j["loaded_map"] = {{"path", options.load_map},
                        {"keyframes", summary.loaded_keyframes},
                        {"map_points", summary.loaded_landmarks},
+                       {"load_ms", summary.map_load_ms},
                        {"localization", options.slam.localization}};
   }
   j["vocabulary"] = slam.vocabulary_path();
@@ -114,7 +168,11 @@ void WriteOutputs(const RgbdDataset& dataset, const Settings& settings, const Ru
                   {"total_per_frame", StatsJson(summary.total)}};
   nlohmann::json per_frame = nlohmann::json::array();
   for (const FrameReport& r : summary.reports) {
+    auto fm = final_map.find(r.stamp.Seconds());
     per_frame.push_back({{"index", r.index},
+                         {"map", r.map_id},  // when tracked
+                         {"final_map", r.tracking.pose_valid && fm != final_map.end() ? fm->second
+                                                                                      : -1},
                          {"stamp", r.stamp.Seconds()},
                          {"state", ToString(r.tracking.state)},
                          {"tracked", r.tracking.pose_valid},
@@ -163,6 +221,7 @@ class RunRecorder {
     ++summary_.frames;
     if (r.tracking.pose_valid) ++summary_.tracked;
     if (r.tracking.relocalized) ++summary_.relocalizations;
+    if (r.tracking.method == "init" || r.tracking.new_map) ++summary_.maps_started;
     if (r.segmentation_ms > 0) seg_.push_back(r.segmentation_ms);
     ext_.push_back(r.timings.extraction_ms);
     trk_.push_back(r.timings.tracking_ms);
@@ -175,7 +234,10 @@ class RunRecorder {
   // Starts `slam` from options.load_map (if any); recorded in the summary.
   void LoadMap(const RunOptions& options, SlamSystem* slam) {
     if (options.load_map.empty()) return;
+    const auto t0 = std::chrono::steady_clock::now();
     const MapFileInfo info = slam->LoadMap(options.load_map);
+    summary_.map_load_ms =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     summary_.loaded_keyframes = info.keyframes;
     summary_.loaded_landmarks = info.landmarks;
   }
@@ -187,6 +249,7 @@ class RunRecorder {
     summary_.segmentation = ComputeErrorStats(seg_);
     slam.WaitForGlobalBundleAdjustment();
     summary_.loops = static_cast<size_t>(slam.loops_closed());
+    summary_.maps_merged = slam.maps_merged();
     summary_.loop_records = slam.loops();
     summary_.loop_detection = slam.loop_detection_stats();
     summary_.global_ba_runs = slam.global_ba_runs();

@@ -37,11 +37,16 @@ struct RunSummary {
   size_t landmarks = 0;
   size_t relocalizations = 0;
   size_t loops = 0;  // loops closed
+  // Several maps: maps started (the first included), merges, maps left at the end, and frames with
+  // a pose in the main map (trajectory.txt; the others go to trajectory_map<N>.txt).
+  int maps_started = 0, maps_merged = 0, maps_left = 0;
+  size_t tracked_main = 0;
   LoopDetectionStats loop_detection;
   int global_ba_runs = 0;     // global bundle adjustments started after loops
   int global_ba_stopped = 0;  // ... stopped early by a newer loop (solution discarded)
   uint64_t map_file_bytes = 0;  // size of the map file written (save_map)
   uint64_t loaded_keyframes = 0, loaded_landmarks = 0;  // of the map loaded (load_map)
+  double map_load_ms = 0;                               // reading and restoring it
   std::vector<LoopRecord> loop_records;
   double wall_s = 0;
   ErrorStats segmentation, extraction, tracking, mapping, total;  // per-stage times, ms

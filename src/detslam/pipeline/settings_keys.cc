@@ -97,6 +97,7 @@ std::vector<Binding> MakeBindings() {
   std::vector<Binding> k;
   // Tracking, local mapping, loop closing.
   k.push_back(Key("Tracking.KeyFrameFarPoints", 0, kInf, "map points a keyframe creates from depth beyond ThDepth", [](auto& r) -> auto& { return r.run.slam.tracker.keyframe_far_points; }));
+  k.push_back(Key("Atlas.NewMapWhenLost", "when a frame can be neither tracked nor relocalised, start a new map from it at once (merged later when place recognition finds the overlap); off: stay lost until relocalisation", [](auto& r) -> auto& { return r.run.slam.tracker.new_map_when_lost; }));
   k.push_back(Key("LocalMapping.BundleAdjustment", "local bundle adjustment after each keyframe", [](auto& r) -> auto& { return r.run.slam.mapper.local_ba; }));
   k.push_back(Key("LocalMapping.MaxLocalKeyFrames", 1, kInf, "keyframes optimised by local BA (current + best covisibles)", [](auto& r) -> auto& { return r.run.slam.mapper.max_local_keyframes; }));
   k.push_back(Key("LocalMapping.Triangulate", "triangulate keypoints without close depth with covisible keyframes", [](auto& r) -> auto& { return r.run.slam.mapper.triangulate; }));

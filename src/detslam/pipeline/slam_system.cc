@@ -20,6 +20,13 @@ double MsSince(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }
 
+// Localisation mode tracks against the loaded map only: no new maps either.
+TrackerOptions TrackerFor(const SlamOptions& options) {
+  TrackerOptions t = options.tracker;
+  if (options.localization) t.new_map_when_lost = false;
+  return t;
+}
+
 }  // namespace
 
 bool SlamOptions::Check(std::string* error) const {
@@ -48,7 +55,7 @@ SlamSystem::SlamSystem(const PinholeCamera& camera, const SlamOptions& options,
       vocabulary_(vocabulary_path_ == "none" ? nullptr : LoadSharedVocabulary(vocabulary_path_)),
       dynamic_(options.dynamic, segmenter),
       store_(MakeScaleInfo(extractor_)),
-      tracker_(camera, options.tracker, options.dynamic.geometric),
+      tracker_(camera, TrackerFor(options), options.dynamic.geometric),
       mapper_(camera, options.mapper),
       loop_closer_(camera, options.loop) {
   std::string error;
@@ -90,9 +97,10 @@ void SlamSystem::MapKeyFrame(KeyFrameId kf, FrameReport* report) {
       report->loop_inliers = loop.inliers;
       report->loop_agreeing = loop.agreeing;
       report->loop_correction_m = loop.correction_m;
+      report->maps_merged = loop.merged;
       loops_.push_back({map->keyframe(loop.keyframe).frame_index, loop.keyframe, loop.candidate,
                         report->loop_candidate_frame, loop.inliers, loop.agreeing,
-                        loop.correction_m});
+                        loop.correction_m, loop.merged, loop.merged_from, loop.merged_into});
       ++loop_generation_;
       global_ba = options_.loop.global_ba_iterations > 0;
     }
@@ -172,6 +180,11 @@ int SlamSystem::global_ba_stopped() const { return global_ba_stopped_; }
 int SlamSystem::loops_closed() const {
   const MapStore::ReadAccess map = store_.Read();
   return loop_closer_.loops_closed();
+}
+
+int SlamSystem::maps_merged() const {
+  const MapStore::ReadAccess map = store_.Read();
+  return loop_closer_.maps_merged();
 }
 
 LoopDetectionStats SlamSystem::loop_detection_stats() const {
@@ -254,13 +267,15 @@ KeyFrameId SlamSystem::TrackFrame(Frame frame, FrameReport* report) {
                                                                    : tracker_.reference_keyframe();
     tracked_.push_back(
         {frame.stamp, ref, *frame.cam_from_world * map.keyframe(ref).cam_from_world.Inverse()});
+    report->map_id = map.MapOf(ref);
   }
   report->keyframe = new_kf != kNoKeyFrame;
   return new_kf;
 }
 
 Rigid3d SlamSystem::ReferenceWorldFromCam(const Map& map, KeyFrameId id,
-                                          const Rigid3d& cam_from_ref) const {
+                                          const Rigid3d& cam_from_ref,
+                                          KeyFrameId* existing) const {
   // Walk up through erased keyframes to one that still exists.
   Rigid3d cam_from_kf = cam_from_ref;
   KeyFrameId kf = id;
@@ -270,23 +285,38 @@ Rigid3d SlamSystem::ReferenceWorldFromCam(const Map& map, KeyFrameId id,
     cam_from_kf = cam_from_kf * it->second.cam_from_parent;
     kf = it->second.parent;
   }
+  if (existing) *existing = kf;
   return (cam_from_kf * map.keyframe(kf).cam_from_world).Inverse();
 }
 
-Trajectory SlamSystem::FrameTrajectory() const {
+MapTrajectories SlamSystem::FrameTrajectories() const {
   const MapStore::ReadAccess map = store_.Read();
-  Trajectory out;
-  out.reserve(tracked_.size());
-  for (const TrackedFrame& t : tracked_)
-    out.push_back({t.stamp, ReferenceWorldFromCam(*map, t.reference, t.cam_from_ref)});
+  MapTrajectories out;
+  for (const TrackedFrame& t : tracked_) {
+    KeyFrameId kf = kNoKeyFrame;
+    const Rigid3d world_from_cam = ReferenceWorldFromCam(*map, t.reference, t.cam_from_ref, &kf);
+    const int map_id = map->MapOf(kf);
+    if (out.main_map < 0) out.main_map = map_id;
+    out.by_map[map_id].push_back({t.stamp, world_from_cam});
+  }
   return out;
+}
+
+Trajectory SlamSystem::FrameTrajectory() const {
+  MapTrajectories all = FrameTrajectories();
+  return all.main_map < 0 ? Trajectory() : std::move(all.by_map[all.main_map]);
 }
 
 Trajectory SlamSystem::KeyFrameTrajectory() const {
   const MapStore::ReadAccess map = store_.Read();
   Trajectory out;
-  for (const auto& [id, kf] : map->keyframes())
-    out.push_back({kf.stamp, kf.cam_from_world.Inverse()});
+  if (tracked_.empty()) return out;
+  KeyFrameId first = kNoKeyFrame;
+  ReferenceWorldFromCam(*map, tracked_.front().reference, tracked_.front().cam_from_ref, &first);
+  const int main_map = map->MapOf(first);
+  for (const auto& [id, kf] : map->keyframes()) {
+    if (kf.map_id == main_map) out.push_back({kf.stamp, kf.cam_from_world.Inverse()});
+  }
   return out;
 }
 

@@ -55,6 +55,15 @@ struct LoopRecord {
   int inliers = 0;                     // verified inliers
   int agreeing = 0;                    // keyframes that agreed on it
   double correction_m = 0;             // how far the pose graph moved the keyframe
+  bool merge = false;                  // the candidate was in another map: two maps merged
+  int merged_from = -1, merged_into = -1;
+};
+
+// Every tracked frame's pose, by the map of the atlas that holds it at the end of the run (maps
+// merged into another count as that one).
+struct MapTrajectories {
+  int main_map = -1;  // the map of the first frame with a pose
+  std::map<int, Trajectory> by_map;
 };
 
 // Wall-clock time of each stage for one frame, milliseconds.
@@ -70,6 +79,7 @@ struct FrameReport {
   Timestamp stamp;
   TrackingResult tracking;
   bool keyframe = false;
+  int map_id = -1;  // the map of the atlas the frame was tracked in (-1: no pose)
   bool loop_closed = false;  // this frame's keyframe closed a loop (mapping in the tracking thread)
   KeyFrameId loop_keyframe = kNoKeyFrame;   // with loop_closed: the keyframe that closed it
   KeyFrameId loop_candidate = kNoKeyFrame;  //   the older keyframe of the same place
@@ -77,6 +87,7 @@ struct FrameReport {
   int loop_inliers = 0;                     //   verified inliers
   int loop_agreeing = 0;                    //   keyframes that agreed on it
   double loop_correction_m = 0;             //   how far the pose graph moved the keyframe
+  bool maps_merged = false;                 //   it was a merge of two maps
   int num_keypoints = 0;
   FrameTimings timings;
 };
@@ -120,16 +131,19 @@ class SlamSystem {
   // report->timings.mapping_ms and loop_closed.
   void MapKeyFrame(KeyFrameId kf, FrameReport* report);
 
-  // Every tracked frame's pose, recomputed from its reference keyframe's current pose.
+  // Every tracked frame's pose, recomputed from its reference keyframe's current pose, by map.
+  MapTrajectories FrameTrajectories() const;
+  // Those of the main map (the map of the first tracked frame, with every map merged into it).
   Trajectory FrameTrajectory() const;
-  // Keyframe poses (world_from_cam) in id order.
+  // Keyframe poses (world_from_cam) of the main map in id order.
   Trajectory KeyFrameTrajectory() const;
   // Read access to the map (holds the lock while it lives).
   MapStore::ReadAccess ReadMap() const { return store_.Read(); }
   // Local-mapping time of every processed keyframe (ms), in processing order.
   std::vector<double> mapping_times_ms() const;
-  // Loops closed so far.
+  // Loops closed so far (merges not included), maps merged so far.
   int loops_closed() const;
+  int maps_merged() const;
   std::vector<LoopRecord> loops() const;
   // Waits for a global bundle adjustment running in its own thread (global_ba_thread), e.g.
   // before the trajectory is written. The destructor stops it instead (after its current
@@ -152,7 +166,10 @@ class SlamSystem {
   const std::string& vocabulary_path() const { return vocabulary_path_; }
 
  private:
-  Rigid3d ReferenceWorldFromCam(const Map& map, KeyFrameId id, const Rigid3d& cam_from_ref) const;
+  // The pose of a tracked frame from its reference keyframe (walking up through erased ones), and
+  // the keyframe it ended at.
+  Rigid3d ReferenceWorldFromCam(const Map& map, KeyFrameId id, const Rigid3d& cam_from_ref,
+                                KeyFrameId* existing = nullptr) const;
 
   PinholeCamera camera_;
   SlamOptions options_;

@@ -1,5 +1,6 @@
 #include "detslam/synth/camera_path.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "detslam/core/check.h"
@@ -120,6 +121,24 @@ Rigid3d CameraPath::WorldFromCam(double t) const {
                             -0.6 + Wave(t, 0.25, 13.0, ph[1]), 1.3 + Wave(t, 0.1, 7.0, ph[2]));
     const Eigen::Matrix3d r = YawPitchRollRotation(Wave(t, 12 * kDeg, 10.0, ph[3]),
                                                    6 * kDeg + Wave(t, 3 * kDeg, 8.0, ph[4]),
+                                                   Wave(t, 2 * kDeg, 6.0, ph[5]));
+    return Rigid3d(r, p);
+  }
+  if (preset_ == "roam") {
+    // Hand-held near (0, -1.0) in the office: faces the table and the far wall (yaw 0) for 7 s,
+    // turns left over 7-11 s to face the back-left corner (yaw 135 deg: boxes, posters, the end
+    // of the back shelf), roams there until 19 s, turns back over 19-25 s to face the front again
+    // and stays there to the end. `--cover 8:2` hides the middle of the first turn: after it, the
+    // camera sees only what it has never seen; it comes back to the start at ~24 s.
+    auto smooth = [](double a, double b, double x) {
+      const double s = std::clamp((x - a) / (b - a), 0.0, 1.0);
+      return s * s * (3.0 - 2.0 * s);
+    };
+    const double yaw = 135 * kDeg * (smooth(7.0, 11.0, t) - smooth(19.0, 25.0, t)) +
+                       Wave(t, 10 * kDeg, 9.0, ph[0]);
+    const Eigen::Vector3d p(Wave(t, 0.35, 15.0, ph[1]), -1.0 + Wave(t, 0.15, 11.0, ph[2]),
+                            1.3 + Wave(t, 0.08, 7.0, ph[3]));
+    const Eigen::Matrix3d r = YawPitchRollRotation(yaw, 8 * kDeg + Wave(t, 3 * kDeg, 8.0, ph[4]),
                                                    Wave(t, 2 * kDeg, 6.0, ph[5]));
     return Rigid3d(r, p);
   }

@@ -11,7 +11,7 @@ namespace detslam {
 const std::vector<std::string>& SynthPresetNames() {
   static const std::vector<std::string> kNames = {
       "static",         "walking_xyz", "walking_static", "walking_rpy", "walking_halfsphere",
-      "sitting_static", "loop",        "loop_long",      "lookalike"};
+      "sitting_static", "loop",        "loop_long",      "lookalike",   "roam"};
   return kNames;
 }
 
@@ -40,6 +40,7 @@ int SynthPresetDefaultFrames(const std::string& preset) {
   if (preset == "loop_long") return 2010;  // one 64 s lap, then 3 s over its start again
   if (preset == "lookalike") return 1350;  // 45 s: first part, passage, second part
   if (preset == "walking_halfsphere") return 900;
+  if (preset == "roam") return 900;  // 30 s: front, turn, back of the room, turn on, front
   if (preset == "walking_static" || preset == "sitting_static") return 700;
   return 800;
 }
@@ -68,8 +69,51 @@ bool SynthOptions::Check(std::string* error) const {
       os << " (at least one frame before and after the cut); ";
     }
   }
+  if (cover_start_s != 0.0 || cover_seconds != 0.0) {
+    const int n =
+        IsSynthPreset(preset) && frames != 0 && frames <= 100000 ? SynthFrameCount(*this) : -1;
+    const double duration = n > 0 ? n / 30.0 : -1;
+    if (!(cover_start_s > 0) || !(cover_seconds > 0) ||
+        (duration > 0 && !(cover_start_s + cover_seconds < duration))) {
+      os << "--cover " << cover_start_s << ":" << cover_seconds
+         << " must start after the first frame and end before the last";
+      if (duration > 0) os << " (the sequence lasts " << duration << " s)";
+      os << "; ";
+    }
+  }
   if (error != nullptr) *error = os.str();
   return os.str().empty();
+}
+
+bool SynthOptions::Covered(int k) const {
+  const double t = k / 30.0;
+  return HasCover() && t >= cover_start_s && t < cover_start_s + cover_seconds;
+}
+
+void ParseSynthCover(const std::string& text, SynthOptions* options) {
+  const auto bad = [&](const std::string& why) {
+    return InputError("--cover '" + text + "': " + why +
+                      " (expected START:SECONDS, seconds from the first frame, SECONDS > 0)");
+  };
+  const size_t colon = text.find(':');
+  if (colon == std::string::npos || text.find(':', colon + 1) != std::string::npos)
+    throw bad("needs exactly one ':'");
+  const auto parse = [&](const std::string& part) {
+    size_t used = 0;
+    double v = 0;
+    try {
+      v = std::stod(part, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (part.empty() || used != part.size() || !std::isfinite(v) || v < 0)
+      throw bad("'" + part + "' is not a non-negative number of seconds");
+    return v;
+  };
+  const double start = parse(text.substr(0, colon)), seconds = parse(text.substr(colon + 1));
+  if (!(seconds > 0)) throw bad("SECONDS must be positive");
+  options->cover_start_s = start;
+  options->cover_seconds = seconds;
 }
 
 void ParseSynthCut(const std::string& text, SynthOptions* options) {

@@ -22,9 +22,16 @@ struct SynthOptions {
   double depth_scale_bias = 0.0;       // F: written depth x (1 + F sin^2(pi k / (N - 1))); 0 = off
   int cut_begin = 0;                   // frames cut_begin..cut_end-1 are not written (`--cut A:B`)
   int cut_end = 0;                     // cut_end <= cut_begin (default 0, 0): no cut
+  // `--cover START:SECONDS`: a covered lens from START for SECONDS (black colour, no depth; the
+  // camera keeps moving and the frames are written). 0 seconds: no cover.
+  double cover_start_s = 0.0;
+  double cover_seconds = 0.0;
 
   // True if frames [cut_begin, cut_end) are to be dropped from the written sequence.
   bool HasCut() const { return cut_end > cut_begin; }
+  bool HasCover() const { return cover_seconds > 0; }
+  // True if frame k (30 Hz) lies under the cover: START <= k / 30 < START + SECONDS.
+  bool Covered(int k) const;
 
   // True if the options are valid; otherwise fills `error` (may be null) with the reasons, each
   // naming its command-line option.
@@ -38,6 +45,9 @@ constexpr double kMaxDepthScaleBias = 0.5;
 // options->cut_end; throws InputError naming --cut otherwise. Whether the cut lies inside the
 // sequence is checked by SynthOptions::Check (it needs the frame count).
 void ParseSynthCut(const std::string& text, SynthOptions* options);
+// Parses `--cover START:SECONDS` (two non-negative numbers, SECONDS > 0) into options->cover_*;
+// throws InputError naming --cover otherwise. Check tests that it lies inside the sequence.
+void ParseSynthCover(const std::string& text, SynthOptions* options);
 
 // Scale of the written depth at frame k of a sequence of `frames` frames with bias F: it rises
 // from 1 at the first frame to 1 + F at the middle and falls back to 1 at the last (sin^2 ramp).

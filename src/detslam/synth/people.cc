@@ -208,6 +208,11 @@ PeopleScript::PeopleScript(const std::string& preset, uint64_t seed) {
     for (auto& w : walkers_) w.axis.normalize();
     return;
   }
+  if (preset == "roam") {
+    // One person strolling behind the central desk, seen when the camera faces the front.
+    walkers_.push_back({{0.2, 2.1}, {1, 0}, 1.0, 16.0, phase(), 0.08, 1.70, false});
+    return;
+  }
   if (preset == "loop") {
     // One person strolling along the far side of the room, behind the central desk (y 2.1; the
     // desk spans y 0.6-1.9, the camera's circuit y -1.6..0.4, so they never meet: earlier the

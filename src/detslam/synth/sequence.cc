@@ -108,7 +108,14 @@ SynthFrame SyntheticSequence::Render(int k) const {
     synth::ApplyMotionBlur(&f.bgr, cv::Point2f(static_cast<float>(uv_b.x() - uv_a.x()),
                                                static_cast<float>(uv_b.y() - uv_a.y())));
   }
-  if (options_.sensor_noise) synth::AddColourNoise(&f.bgr, sensor_, options_.seed, k);
+  if (options_.Covered(k)) {
+    // A covered lens: nothing but black and no depth (the depth camera is covered too).
+    f.bgr.setTo(cv::Scalar::all(0));
+    ideal.depth.setTo(0.0f);
+    f.instance_mask.setTo(0);
+  } else if (options_.sensor_noise) {
+    synth::AddColourNoise(&f.bgr, sensor_, options_.seed, k);
+  }
   // A miscalibrated sensor (--depth-scale-bias): every depth it measures is `scale` x the truth.
   // true_depth and the pose stay true.
   const double scale = DepthScaleOf(k);

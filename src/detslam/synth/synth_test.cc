@@ -44,7 +44,7 @@ TEST(SynthOptionsTest, UnknownPresetIsAnInputErrorListingValidOnes) {
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("walking_halfsphere"), std::string::npos) << e.what();
   }
-  EXPECT_EQ(SynthPresetNames().size(), 9u);
+  EXPECT_EQ(SynthPresetNames().size(), 10u);
 }
 
 TEST(SynthSequenceTest, DepthBackProjectsOntoSceneSurfaces) {
@@ -237,7 +237,9 @@ TEST(SynthSequenceTest, StampsAndMotionAreRealistic) {
       max_rate = std::max(max_rate, delta.RotationAngle() * 30.0 * 180.0 / M_PI);
     }
     EXPECT_LT(max_speed, 0.6) << preset;  // m/s
-    EXPECT_LT(max_rate, 40.0) << preset;  // deg/s
+    // deg/s; roam turns 135 deg in 4 s (a quick hand-held turn, peak ~58 deg/s; TUM's fr1/360
+    // averages 41 deg/s)
+    EXPECT_LT(max_rate, preset == "roam" ? 65.0 : 40.0) << preset;
   }
   // The loop returns to its start.
   synth::CameraPath loop("loop", 1);

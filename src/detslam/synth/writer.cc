@@ -41,6 +41,7 @@ std::string Describe(const SynthOptions& o) {
   if (o.motion_blur) os << " --blur";
   if (o.depth_scale_bias != 0.0) os << " --depth-scale-bias " << o.depth_scale_bias;
   if (o.HasCut()) os << " --cut " << o.cut_begin << ":" << o.cut_end;
+  if (o.HasCover()) os << " --cover " << o.cover_start_s << ":" << o.cover_seconds;
   return os.str();
 }
 

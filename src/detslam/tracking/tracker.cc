@@ -156,6 +156,17 @@ TrackingResult Tracker::Track(Map& map, Frame* frame) {
     frame->cam_from_world.reset();
     velocity_.reset();
     result.method = "lost";
+    if (options_.new_map_when_lost && map.NumKeyFrames() > 0 && Initialize(map, frame)) {
+      // Relocalisation failed too: the frame starts a new map of the atlas.
+      state_ = TrackingState::kOk;
+      result.pose_valid = true;
+      result.new_map = true;
+      result.method = "new map";
+      last_frame_ = *frame;
+      BuildTemporaryPoints(map);
+      spdlog::warn("frame {}: started map {} (tracking lost)", frame->index,
+                   map.MapOf(reference_kf_));
+    }
   }
   result.state = state_;
   return result;
@@ -166,9 +177,15 @@ bool Tracker::Initialize(Map& map, Frame* frame) {
   int with_depth = 0;
   for (size_t i = 0; i < f.size(); ++i) with_depth += f.depth[i] > 0 ? 1 : 0;
   if (with_depth < options_.min_init_keypoints) return false;
+  PrepareFrame(frame);
   frame->cam_from_world = Rigid3d::Identity();
-  CreateKeyFrame(map, frame);
-  spdlog::info("map initialised with {} landmarks", map.NumLandmarks());
+  new_map_id_ = map.NewMapId();
+  const KeyFrameId kf = CreateKeyFrame(map, frame);
+  new_map_id_ = -1;
+  spdlog::info("map {} initialised with {} landmarks", map.MapOf(kf),
+               map.keyframe(kf).landmarks.size() -
+                   std::count(map.keyframe(kf).landmarks.begin(),
+                              map.keyframe(kf).landmarks.end(), kNoLandmark));
   return true;
 }
 

@@ -35,6 +35,11 @@ struct TrackerOptions {
   double ref_ratio = 0.75;                // thRefRatio (0.4 with one keyframe)
   int close_tracked_max = 100;            // bNeedToInsertClose: tracked close < this
   int close_untracked_min = 70;           //                      and untracked close > this
+  // Several maps: when a frame can neither be tracked nor relocalised, start a new map from it at
+  // once (RGB-D initialises from one frame), so that no stretch is left without poses; the old
+  // maps stay, relocalisation and loop closing search them too, and a verified overlap merges
+  // them (loop/loop_closer.h). false: stay lost until relocalisation succeeds (one map).
+  bool new_map_when_lost = true;
   uint64_t seed = 42;                     // relocalisation RANSAC
   bool Check(std::string* error) const;
 };
@@ -46,7 +51,9 @@ struct TrackingResult {
   bool relocalized = false;
   int num_inliers = 0;         // landmark inliers after local-map tracking
   int geometric_rejected = 0;  // keypoints the geometric check labelled kGeometric
-  std::string method;          // "init", "motion", "reference", "relocalization", "lost"
+  // "init", "motion", "reference", "relocalization", "new map", "lost"
+  std::string method;
+  bool new_map = false;  // this frame started a new map (after tracking was lost)
 };
 
 // The tracker borrows the map for each call: its callers hold the map store's write access (which
@@ -127,6 +134,7 @@ class Tracker {
 
   // Clears the frame's associations, outlier flags and labels, and the scratch state.
   void PrepareFrame(Frame* frame);
+  // Starts a map (the first one, or a new one of the atlas) with `frame` as its root at the origin.
   bool Initialize(Map& map, Frame* frame);
   bool TrackWithMotionModel(const Map& map, Frame* frame);
   bool TrackReferenceKeyFrame(const Map& map, Frame* frame);
@@ -157,6 +165,7 @@ class Tracker {
   std::vector<std::optional<Eigen::Vector3d>> temporary_points_;  // per last-frame keypoint
   std::optional<Rigid3d> velocity_;  // cam_from_world(k) * world_from_cam(k-1)
   KeyFrameId reference_kf_ = kNoKeyFrame;
+  int new_map_id_ = -1;  // >= 0 while Initialize makes the first keyframe of that map
   KeyFrameId last_keyframe_ = kNoKeyFrame;
   int64_t last_keyframe_frame_ = 0;
   bool keyframe_requested_ = false;  // RequestKeyFrame; cleared by the next keyframe

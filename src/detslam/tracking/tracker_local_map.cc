@@ -223,6 +223,7 @@ KeyFrameId Tracker::CreateKeyFrame(Map& map, Frame* frame) {
   kf.cam_from_world = *frame->cam_from_world;
   kf.features = frame->features;
   kf.labels = frame->labels;
+  kf.map_id = new_map_id_ >= 0 ? new_map_id_ : map.MapOf(reference_kf_);
   const KeyFrameId id = map.AddKeyFrame(std::move(kf));
   for (size_t i = 0; i < frame->size(); ++i) {
     const LandmarkId lm = frame->landmarks[i];

@@ -1,0 +1,77 @@
+// Several maps (the atlas) on the roam preset with a covered lens: while the lens is covered the
+// camera turns towards ground it has never seen, so relocalisation cannot succeed afterwards. A new
+// map must start from the first frame after the cover, the camera's return to its start must merge
+// it into the first map, and trajectory.txt (the main map) must then hold every frame that is not
+// black, as accurately as the uncovered twin's.
+#include <gtest/gtest.h>
+
+#include <opencv2/imgproc.hpp>
+
+#include "detslam/eval/ate.h"
+#include "detslam/pipeline/slam_system.h"
+#include "detslam/synth/sequence.h"
+
+namespace detslam {
+namespace {
+
+struct AtlasRun {
+  int frames = 0, black = 0;
+  int new_maps = 0;          // frames that started a new map after tracking was lost
+  int first_map_after = -1;  // map of the first frame tracked after the cover
+  int merges = 0;
+  size_t main_frames = 0;  // frames in the main map at the end
+  size_t maps_left = 0;
+  double ate_m = 0;
+};
+
+AtlasRun RunRoam(const SynthOptions& so) {
+  const SyntheticSequence seq(so);
+  SlamSystem slam(seq.camera(), SlamOptions());
+  Trajectory gt;
+  AtlasRun run;
+  for (int k = 0; k < seq.size(); ++k) {
+    const SynthFrame f = seq.Render(k);
+    cv::Mat gray, depth;
+    cv::cvtColor(f.bgr, gray, cv::COLOR_BGR2GRAY);
+    f.depth16.convertTo(depth, CV_32F, 1.0 / seq.camera().depth_map_factor);
+    const FrameReport r = slam.ProcessFrame(k, f.stamp, gray, depth);
+    ++run.frames;
+    run.black += so.Covered(k) ? 1 : 0;
+    run.new_maps += r.tracking.new_map ? 1 : 0;
+    if (k >= 240 && !so.Covered(k) && run.first_map_after < 0 && r.tracking.pose_valid)
+      run.first_map_after = r.map_id;
+    gt.push_back({f.stamp, f.world_from_cam});
+  }
+  run.merges = slam.maps_merged();
+  const MapTrajectories all = slam.FrameTrajectories();
+  run.maps_left = all.by_map.size();
+  run.main_frames = all.by_map.at(all.main_map).size();
+  run.ate_m = ComputeAte(gt, all.by_map.at(all.main_map), AteOptions()).error_m.rmse;
+  return run;
+}
+
+TEST(IntegrationAtlas, CoveredLensStartsANewMapThatMergesOnTheWayBack) {
+  SynthOptions so;
+  so.preset = "roam";
+  so.seed = 2;
+  so.people = false;  // no segmenter here: the people are the dynamic benchmarks' business
+  const AtlasRun plain = RunRoam(so);
+  so.cover_start_s = 8.0;
+  so.cover_seconds = 2.0;
+  const AtlasRun covered = RunRoam(so);
+
+  EXPECT_EQ(plain.new_maps, 0);
+  EXPECT_EQ(plain.main_frames, static_cast<size_t>(plain.frames));
+  EXPECT_EQ(covered.black, 60);
+  EXPECT_EQ(covered.new_maps, 1);
+  EXPECT_EQ(covered.first_map_after, 1);  // relocalisation in map 0 cannot succeed there
+  EXPECT_EQ(covered.merges, 1);
+  EXPECT_EQ(covered.maps_left, 1u);
+  // Every frame that is not black ends up in the main map.
+  EXPECT_GE(covered.main_frames, static_cast<size_t>(0.95 * (covered.frames - covered.black)));
+  EXPECT_LE(covered.ate_m, 1.5 * plain.ate_m + 0.002)
+      << "ATE covered " << covered.ate_m << " m, plain " << plain.ate_m << " m";
+}
+
+}  // namespace
+}  // namespace detslam
