@@ -114,6 +114,11 @@ void Run(const RunArgs& a) {
   const RunSummary s = Run(dataset, settings, options, [&](size_t d, size_t t, const FrameReport& r) { bar.Update(d, t, r); }, segmenter.get());
   std::printf("tracked %zu/%zu frames (%.1f%%), %zu keyframes, %zu map points, %zu relocalisations, %zu loops closed\n",
               s.tracked, s.frames, 100.0 * s.TrackedFraction(), s.keyframes, s.landmarks, s.relocalizations, s.loops);
+  if (s.maps_started > 1 || s.maps_left > 1) {
+    std::printf("maps: %d started (tracking lost, relocalisation failed), %d merged, %d left; trajectory.txt holds %zu frames%s\n",
+                s.maps_started, s.maps_merged, s.maps_left, s.tracked_main,
+                s.maps_left > 1 ? " (the other maps: trajectory_map<N>.txt, each in its own frame)" : "");
+  }
   if (!s.segmenter.empty()) std::printf("segmentation (%s): median %.1f ms per frame\n", s.segmenter.c_str(), s.segmentation.median);
   std::printf("median ms per frame: extraction %.1f, tracking %.1f, total %.1f; local mapping %.1f per keyframe\n",
               s.extraction.median, s.tracking.median, s.total.median, s.mapping.median);

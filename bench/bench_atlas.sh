@@ -169,3 +169,4 @@ PY
 } >"$out"
 publish atlas-files "$out"
 fi
+python3 "$here/readme_summary.py"

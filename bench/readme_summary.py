@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """Writes the README's benchmark summary table from the measured tables in docs/BENCHMARKS.md.
 
-The numbers come only from the sections the benchmark commands wrote (slam, dynamic); this script
+The numbers come only from the sections the benchmark commands wrote (slam, dynamic, atlas-cover,
+atlas-files); this script
 condenses them (per preset: seeds, frames tracked, ATE ratio to the static twin) and names the
 sections and their dates. The benchmark commands call it at the end; it can also be run alone.
 Usage: bench/readme_summary.py
@@ -102,10 +103,28 @@ def summary(bench_text):
             fps_text = f"{fps.group(1)} fps" + (f" (runs: {fps.group(2)})" if fps.group(2) else "")
             rows.append((f"Live threaded pipeline, {what}", fps_text,
                          f"ATE {r['ATE mm (tracked)']} mm (walking_xyz seed 1)"))
+    cover = section(bench_text, "atlas-cover")
+    if cover:
+        # The over-the-seeds table (mean, worst) of the covered-lens benchmark.
+        over = next((t for t in tables(cover) if t and "sequence, mode" in t[0]), [])
+        for r in over:
+            rows.append((f"Covered lens 2 s (roam, synthetic): {r['sequence, mode']}",
+                         f"{r['not-black frames posed %: mean']} % of not-black frames in trajectory.txt "
+                         f"(worst {r['worst']} %)",
+                         f"ATE RMSE {r['ATE RMSE mm: mean']} mm, "
+                         f"{r['ATE / uncovered: mean']}x the uncovered run's"))
+    files = section(bench_text, "atlas-files")
+    if files:
+        table = next((t for t in tables(files) if t and "ATE / SLAM run of that path" in t[0]), [])
+        for r in table:
+            if "--load-map" in r["run"]:
+                rows.append((f"Map file (static, synthetic): {r['run']}",
+                             f"{r['frames tracked']} tracked, {r['keyframes added']} keyframes added",
+                             f"ATE RMSE {r['ATE RMSE mm']} mm, {r['ATE / SLAM run of that path']}x the SLAM run's"))
     lines = ["| benchmark | frames | accuracy |", "|---|---|---|"]
     lines += [f"| {a} | {b} | {c} |" for a, b, c in rows]
     sources = []
-    for name in ("slam", "dynamic"):
+    for name in ("slam", "dynamic", "atlas-cover", "atlas-files"):
         body = section(bench_text, name)
         if body:
             sources.append(f"`{name}` ({stamp_date(body)})")

@@ -7,9 +7,13 @@ Usage:
   slam_metrics.py drift groundtruth.txt trajectory.txt -> prints 'drift_m path_m'
   slam_metrics.py kidnap run.json groundtruth.txt trajectory.txt FRAME
       -> prints 'frames_lost frame method error_m': after the jump at input frame FRAME, how many
-         frames went by until one was tracked again (-1 -1 - -1 if none was), that frame's index,
-         how it was tracked (motion, reference, relocalization) and its position error (first
-         poses aligned, as for the drift)
+         frames went by until one had a pose in trajectory.txt again (-1 -1 - -1 if none did), that
+         frame's index, how it was tracked (motion, reference, relocalization, or
+         new_map_merged_later: in a new map that later merged into the main one) and its position
+         error (first poses aligned, as for the drift)
+  slam_metrics.py loops run.json groundtruth.txt MAX_M
+      -> prints 'true false': the run's loops split by ground truth (false: the true camera centres
+         of the loop's frame and its candidate's frame are more than MAX_M apart)
   slam_metrics.py nearest groundtruth.txt ROW
       -> prints 'distance_m angle_deg': how far ground-truth pose ROW (0-based row of the file) is
          from the closest of rows 0..ROW-1, closest by distance + angle / (30 deg per m)
@@ -101,12 +105,37 @@ def position_error_at(gt_path, est_path, stamp):
 
 def kidnap(run_json, gt_path, est_path, jump_frame):
     with open(run_json) as f:
-        frames = json.load(f)["per_frame"]
-    for r in frames:
-        if r["index"] >= jump_frame and r["tracked"]:
+        run = json.load(f)
+    main = run.get("maps", {}).get("main", 0)
+    for r in run["per_frame"]:
+        # A pose in trajectory.txt: tracked, and in the main map at the end (several maps: a frame
+        # of a new map counts once that map merged into the main one).
+        if r["index"] >= jump_frame and r["tracked"] and r.get("final_map", main) == main:
             err = position_error_at(gt_path, est_path, r["stamp"])
-            return r["index"] - jump_frame, r["index"], r["method"], err
+            how = r["method"] if r.get("map", main) == main else "new_map_merged_later"
+            return r["index"] - jump_frame, r["index"], how.replace(" ", "_"), err
     return -1, -1, "-", -1
+
+
+def loops(run_json, gt_path, max_m):
+    """Loops closed in a run, split by ground truth: false when the true camera centres of the
+    loop's frame and of its candidate's frame are more than max_m apart."""
+    with open(run_json) as f:
+        run = json.load(f)
+    stamp = {r["index"]: r["stamp"] for r in run["per_frame"]}
+    gt = read_tum(gt_path)
+
+    def centre(t):
+        return min(gt, key=lambda g: abs(g[0] - t))[1:4]
+
+    true_n = false_n = 0
+    for loop in run["loops"]:
+        d = math.dist(centre(stamp[loop["frame"]]), centre(stamp[loop["candidate_frame"]]))
+        if d > max_m:
+            false_n += 1
+        else:
+            true_n += 1
+    return true_n, false_n
 
 
 def nearest(gt_path, row):
@@ -128,6 +157,9 @@ def nearest(gt_path, row):
 def main():
     if len(sys.argv) == 6 and sys.argv[1] == "kidnap":
         print("%d %d %s %.4f" % kidnap(sys.argv[2], sys.argv[3], sys.argv[4], int(sys.argv[5])))
+        return
+    if len(sys.argv) == 5 and sys.argv[1] == "loops":
+        print("%d %d" % loops(sys.argv[2], sys.argv[3], float(sys.argv[4])))
         return
     if len(sys.argv) == 4 and sys.argv[1] == "nearest":
         print("%.4f %.2f" % nearest(sys.argv[2], int(sys.argv[3])))

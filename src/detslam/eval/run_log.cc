@@ -54,6 +54,17 @@ RunLog ReadRunLog(const std::string& path) {
   r.relocalizations = Get<int64_t>(j, "relocalizations", path, "");
   r.loops_closed = Get<int64_t>(j, "loops_closed", path, "");
   r.wall_s = Get<double>(j, "wall_s", path, "");
+  if (j.contains("maps")) {  // written since several maps; older run logs have none
+    const json& m = j["maps"];
+    r.maps.main = Get<int>(m, "main", path, "maps: ");
+    r.maps.started = Get<int>(m, "started", path, "maps: ");
+    r.maps.merged = Get<int>(m, "merged", path, "maps: ");
+    r.maps.left = Get<int>(m, "left", path, "maps: ");
+    r.maps.frames_in_main = Get<int64_t>(j, "frames_in_main_map", path, "");
+    const json merges = Get<json>(m, "merges", path, "maps: ");
+    if (!merges.is_array()) throw InputError(path, 0, "key 'maps.merges' must be an array");
+    for (const json& x : merges) r.maps.merge_frames.push_back(Get<int64_t>(x, "frame", path, "maps.merges: "));
+  }
   const json frames = Get<json>(j, "per_frame", path, "");
   if (!frames.is_array()) throw InputError(path, 0, "key 'per_frame' must be an array");
   for (size_t k = 0; k < frames.size(); ++k) {
@@ -77,6 +88,8 @@ RunLog ReadRunLog(const std::string& path) {
     l.extraction_ms = Get<double>(f, "extraction_ms", path, where);
     l.tracking_ms = Get<double>(f, "tracking_ms", path, where);
     l.mapping_ms = Get<double>(f, "mapping_ms", path, where);
+    if (f.contains("map")) l.map = Get<int>(f, "map", path, where);
+    if (f.contains("final_map")) l.final_map = Get<int>(f, "final_map", path, where);
     r.per_frame.push_back(std::move(l));
   }
   return r;

@@ -1,6 +1,7 @@
 // What `detslam report` reads back from a `detslam run` output folder: from run.json (written by
 // pipeline/runner.cc) the dataset, settings source, mode, segmenter, counts, wall time and the
-// per-frame log with its stage timings; the summary "timings" and the other keys are not read.
+// per-frame log with its stage timings and maps, the atlas summary ("maps"); the summary "timings"
+// and the other keys are not read.
 #pragma once
 
 #include <cstdint>
@@ -23,6 +24,16 @@ struct RunFrameLog {
   int rejected_keypoints = 0;  // keypoints the dynamic filter rejected
   int geometric_rejected = 0;  // keypoints the geometric check labelled
   double segmentation_ms = 0, extraction_ms = 0, tracking_ms = 0, mapping_ms = 0;
+  int map = -1;        // map of the atlas it was tracked in (-1: no pose, or an older run log)
+  int final_map = -1;  // map that holds it at the end (maps merged count as the one they joined)
+};
+
+// Several maps (run.json "maps"; absent in older run logs: main -1).
+struct RunMapsLog {
+  int main = -1;            // the map of trajectory.txt
+  int started = 0, merged = 0, left = 0;
+  int64_t frames_in_main = 0;             // frames in trajectory.txt
+  std::vector<int64_t> merge_frames;      // input frame of each merge
 };
 
 struct RunLog {
@@ -31,6 +42,7 @@ struct RunLog {
   int64_t frames = 0, frames_tracked = 0, keyframes = 0, map_points = 0;
   int64_t relocalizations = 0, loops_closed = 0;
   double wall_s = 0;
+  RunMapsLog maps;
   std::vector<RunFrameLog> per_frame;
 
   double TrackedFraction() const {

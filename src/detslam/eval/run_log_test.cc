@@ -87,6 +87,30 @@ TEST_F(RunLogTest, ReadsCountsAndFrames) {
   EXPECT_DOUBLE_EQ(f.tracking_ms, 3.5);
 }
 
+TEST_F(RunLogTest, ReadsTheMapsOfTheAtlasWhereTheRunWroteThem) {
+  // An older run log has no maps: main -1, frames without map.
+  RunLog r = ReadRunLog(Write(RunJson(kFrame)));
+  EXPECT_EQ(r.maps.main, -1);
+  EXPECT_EQ(r.per_frame[0].map, -1);
+  std::string frame = kFrame;
+  frame.replace(frame.find("\"index\": 1,"), 11, "\"index\": 1, \"map\": 1, \"final_map\": 0,");
+  std::string text = RunJson(frame);
+  text.replace(text.find("\"per_frame\""), 0,
+               R"("frames_in_main_map": 1, "maps": {"main": 0, "started": 2, "merged": 1,
+               "left": 1, "merges": [{"frame": 685, "from": 1, "into": 0}]}, )");
+  r = ReadRunLog(Write(text));
+  EXPECT_EQ(r.maps.main, 0);
+  EXPECT_EQ(r.maps.started, 2);
+  EXPECT_EQ(r.maps.merged, 1);
+  EXPECT_EQ(r.maps.left, 1);
+  EXPECT_EQ(r.maps.frames_in_main, 1);
+  EXPECT_EQ(r.maps.merge_frames, std::vector<int64_t>{685});
+  EXPECT_EQ(r.per_frame[0].map, 1);
+  EXPECT_EQ(r.per_frame[0].final_map, 0);
+  text.replace(text.find("\"started\": 2"), 12, "\"started\": \"two\"");
+  EXPECT_THAT(Error(Write(text)), HasSubstr("maps: key 'started' has the wrong type"));
+}
+
 TEST_F(RunLogTest, BadInputNamesTheFileLineAndKey) {
   EXPECT_THAT(Error((dir_ / "missing.json").string()), HasSubstr("cannot open run log"));
   // A syntax error on line 3.

@@ -85,6 +85,47 @@ size_t LongestLost(const RunLog& run) {
   return longest;
 }
 
+// The map of the atlas each frame was tracked in: a strip of colours along the top of panel `p`,
+// and the merges as dashed full-height lines.
+void DrawMaps(std::ostringstream& os, const RunLog& run, const svg::Panel& p) {
+  static const char* kMapColors[] = {"#1f77b4", "#ff7f0e", "#2ca02c", "#d62728",
+                                     "#9467bd", "#8c564b", "#e377c2", "#17becf"};
+  for (const RunFrameLog& f : run.per_frame) {
+    if (f.map < 0) continue;
+    const double a = p.X(static_cast<double>(f.index) - 0.5);
+    const double b = p.X(static_cast<double>(f.index) + 0.5);
+    os << "<rect x='" << svg::Num(a) << "' y='" << svg::Num(p.y + 1) << "' width='"
+       << svg::Num(std::max(0.5, b - a)) << "' height='6' fill='" << kMapColors[f.map % 8]
+       << "'><title>frame " << f.index << ": map " << f.map << "</title></rect>\n";
+  }
+  for (int64_t frame : run.maps.merge_frames) {
+    const double x = p.X(static_cast<double>(frame));
+    os << "<line x1='" << svg::Num(x) << "' y1='" << svg::Num(p.y) << "' x2='" << svg::Num(x)
+       << "' y2='" << svg::Num(p.y + p.h) << "' stroke='" << kOrange
+       << "' stroke-width='2' stroke-dasharray='5,3'><title>maps merged at frame " << frame
+       << "</title></line>\n";
+  }
+}
+
+// "A-B (n frames)" for every stretch of frames without a pose.
+std::string LostStretches(const RunLog& run) {
+  std::string out;
+  const auto& fr = run.per_frame;
+  int shown = 0;
+  for (size_t k = 0; k < fr.size(); ++k) {
+    if (fr[k].tracked) continue;
+    size_t end = k;
+    while (end + 1 < fr.size() && !fr[end + 1].tracked) ++end;
+    if (++shown <= 12) {
+      out += (out.empty() ? "" : ", ") + std::to_string(fr[k].index) + "-" +
+             std::to_string(fr[end].index) + " (" + std::to_string(end - k + 1) + ")";
+    }
+    k = end;
+  }
+  if (shown > 12) out += ", ... (" + std::to_string(shown) + " stretches)";
+  return out.empty() ? "none" : out;
+}
+
 std::string TableRow(const std::string& key, const std::string& value) {
   return "<tr><th>" + svg::Escape(key) + "</th><td>" + svg::Escape(value) + "</td></tr>\n";
 }
@@ -126,6 +167,7 @@ std::string RenderRunSvg(const RunLog& run) {
        << svg::Num(x) << "' y2='" << svg::Num(track.y + track.h - 8) << "' stroke='" << kGreen
        << "'/>\n";
   }
+  DrawMaps(os, run, track);
   for (const RunFrameLog& f : run.per_frame) {  // loop closures: full-height lines
     if (!f.loop_closed) continue;
     const double x = track.X(static_cast<double>(f.index));
@@ -145,7 +187,8 @@ std::string RenderRunSvg(const RunLog& run) {
               {{"keypoints", kGrey},
                {"landmark inliers", kBlue},
                {"keyframe (tick)", kGreen},
-               {"loop closed", kPurple}});
+               {"loop closed", kPurple},
+               {"maps merged (dashed); strip: map", kOrange}});
 
   svg::Axes(os, dyn, "(b) Dynamic objects: rejected keypoints per frame", "frame", "keypoints");
   RightAxis(os, dyn, inst_r, "dynamic objects", kGrey);
@@ -213,6 +256,16 @@ std::string RenderHtmlReport(const RunLog& run, const EvalResult* eval) {
      << ">" << run.frames_tracked << " / " << run.frames << " ("
      << Fixed(100.0 * run.TrackedFraction(), 1) << " %); longest run without pose: " << lost
      << " frames</td></tr>\n";
+  if (run.maps.main >= 0) {
+    os << TableRow("maps (atlas)",
+                   "started " + std::to_string(run.maps.started) + ", merged " +
+                       std::to_string(run.maps.merged) + ", left " +
+                       std::to_string(run.maps.left) + "; trajectory.txt (map " +
+                       std::to_string(run.maps.main) + "): " +
+                       std::to_string(run.maps.frames_in_main) + " frames" +
+                       (run.maps.left > 1 ? "; the other maps: trajectory_map<N>.txt" : ""))
+       << TableRow("stretches without a pose (frames)", LostStretches(run));
+  }
   os << TableRow("keyframes / map points",
                  std::to_string(run.keyframes) + " / " + std::to_string(run.map_points))
      << TableRow("relocalisations / loops closed",

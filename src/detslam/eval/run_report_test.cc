@@ -75,6 +75,26 @@ TEST(RunReport, PerFrameFigureHasItsPanelsLinesAndMarks) {
   EXPECT_EQ(svg.find("nan"), std::string::npos);
 }
 
+TEST(RunReport, ShowsTheMapOfEveryFrameTheMergesAndTheLostStretches) {
+  RunLog run = HandLog();
+  EXPECT_THAT(RenderHtmlReport(run, nullptr), Not(HasSubstr("maps (atlas)")));  // older log
+  for (RunFrameLog& f : run.per_frame) f.map = !f.tracked ? -1 : f.index < 5 ? 0 : 1;
+  run.maps.main = 0;
+  run.maps.started = 2;
+  run.maps.merged = 1;
+  run.maps.left = 1;
+  run.maps.frames_in_main = 17;
+  run.maps.merge_frames = {14};
+  const std::string svg = RenderRunSvg(run);
+  EXPECT_THAT(svg, HasSubstr("frame 3: map 0"));
+  EXPECT_THAT(svg, HasSubstr("frame 12: map 1"));
+  EXPECT_THAT(svg, Not(HasSubstr("frame 6: map")));  // no pose
+  EXPECT_THAT(svg, HasSubstr("maps merged at frame 14"));
+  const std::string html = RenderHtmlReport(run, nullptr);
+  EXPECT_THAT(html, HasSubstr("started 2, merged 1, left 1; trajectory.txt (map 0): 17 frames"));
+  EXPECT_THAT(html, HasSubstr("5-7 (3)"));
+}
+
 TEST(RunReport, HtmlWithoutGroundTruthSummarisesTheRun) {
   const std::string html = RenderHtmlReport(HandLog(), nullptr);
   EXPECT_EQ(html.rfind("<!DOCTYPE html>", 0), 0u);

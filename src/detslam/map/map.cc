@@ -118,6 +118,14 @@ Map Map::Restore(ScaleInfo scale, std::vector<KeyFrame> keyframes, std::vector<L
         fail("map point " + std::to_string(id) + ": observed from two maps");
     }
   }
+  // Ids are assigned in order, so the next ids lie just past the last ones kept (beyond them only
+  // by elements erased at the end); a next id far beyond would make the first new element's index
+  // allocation huge (a damaged or crafted file).
+  constexpr int64_t kMaxIdGap = int64_t(1) << 24;
+  const int64_t last_lm_kept = map.landmarks_.empty() ? -1 : map.landmarks_.rbegin()->first;
+  if (next_keyframe_id - (last_kf + 1) > kMaxIdGap ||
+      next_landmark_id - (last_lm_kept + 1) > kMaxIdGap)
+    fail("next keyframe or map point id implausibly far beyond the last one kept");
   map.RebuildIndex();
   return map;
 }

@@ -26,8 +26,9 @@ std::vector<KeyFrameId> AddChain(Map* map, int map_id, double x0, size_t shared)
     KeyFrame kf;
     kf.map_id = map_id;
     kf.features = Features(2 * shared + 2);
-    kf.cam_from_world = Rigid3d(Eigen::Quaterniond(Eigen::AngleAxisd(0.1 * k, Eigen::Vector3d::UnitY())),
-                                Eigen::Vector3d(-x0 - 0.2 * k, 0.05 * k, 0.0));
+    kf.cam_from_world =
+        Rigid3d(Eigen::Quaterniond(Eigen::AngleAxisd(0.1 * k, Eigen::Vector3d::UnitY())),
+                Eigen::Vector3d(-x0 - 0.2 * k, 0.05 * k, 0.0));
     ids.push_back(map->AddKeyFrame(std::move(kf)));
   }
   for (int k = 0; k + 1 < 3; ++k) {

@@ -281,6 +281,13 @@ TEST(MapRestore, RefusesPartsThatBreakTheMapsInvariants) {
     std::swap(k[0], k[1]);  // ids not ascending
     EXPECT_THROW(restore(k, l), InputError);
   }
+  {
+    auto [k, l] = parts();  // a next id that would make the first new keyframe allocate terabytes
+    EXPECT_THROW(Map::Restore(map.scale(), k, l, int64_t(1) << 40, map.next_landmark_id()),
+                 InputError);
+    EXPECT_THROW(Map::Restore(map.scale(), k, l, map.next_keyframe_id(), int64_t(1) << 40),
+                 InputError);
+  }
 }
 
 }  // namespace

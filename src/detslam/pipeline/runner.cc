@@ -59,10 +59,15 @@ void WriteOutputs(const RgbdDataset& dataset, const Settings& settings, const Ru
                      header);
   WriteTumTrajectory((out / "keyframes.txt").string(), slam.KeyFrameTrajectory(),
                      "detslam keyframes of " + dataset.dir());
-  std::vector<Eigen::Vector3d> points;
-  for (const auto& [id, lm] : slam.ReadMap()->landmarks()) {
-    (void)id;
-    points.push_back(lm.position);
+  std::vector<Eigen::Vector3d> points;  // of the main map (the others are in frames of their own)
+  {
+    const MapStore::ReadAccess map = slam.ReadMap();
+    for (const auto& [id, lm] : map->landmarks()) {
+      (void)id;
+      if (!lm.observations.empty() &&
+          map->MapOf(lm.observations.begin()->first) == trajectories.main_map)
+        points.push_back(lm.position);
+    }
   }
   WritePointCloudPly((out / "map.ply").string(), points, {});
   if (!options.save_map.empty()) summary.map_file_bytes = slam.SaveMap(options.save_map);

@@ -37,8 +37,8 @@ TEST(SynthRoamTest, CoverParsesAndBadCoversNameTheOption) {
   EXPECT_TRUE(o.Covered(240));   // 8.000 s
   EXPECT_TRUE(o.Covered(299));
   EXPECT_FALSE(o.Covered(300));  // 10.000 s
-  for (const std::string bad : {"", "8", "8:", ":2", "8:0", "a:2", "8:b", "-1:2", "1:2:3", "8:nan",
-                                "8:inf", "8:2x"}) {
+  for (const std::string bad :
+       {"", "8", "8:", ":2", "8:0", "a:2", "8:b", "-1:2", "1:2:3", "8:nan", "8:inf", "8:2x"}) {
     SynthOptions b = Opts("roam");
     const std::string error = CoverErrorOf(bad, &b);
     EXPECT_NE(error.find("--cover"), std::string::npos) << "'" << bad << "': " << error;
@@ -88,7 +88,8 @@ TEST(SynthRoamTest, TurnsToTheUnseenBackOfTheRoomAndComesBackToTheStart) {
     // It faces the back-left corner in the middle (135 deg away) and the front again at the end.
     EXPECT_GT(angle(0, 450), 110.0);
     EXPECT_LT(angle(0, 870), 30.0);
-    EXPECT_LT((seq.WorldFromCam(870).translation() - seq.WorldFromCam(0).translation()).norm(), 1.0);
+    EXPECT_LT((seq.WorldFromCam(870).translation() - seq.WorldFromCam(0).translation()).norm(),
+              1.0);
   }
 }
 
