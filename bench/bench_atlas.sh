@@ -27,26 +27,12 @@ roam_seeds="${ROAM_SEEDS:-3 4 5}"
 map_frames="${MAP_FRAMES:-500}"
 big_frames="${BIG_FRAMES:-3000}"
 parts="${PARTS:-A B C}"
-want() { [[ " $parts " == *" $1 "* ]]; }
 settings_line="bench/bench_atlas.sh (ROAM_SEEDS=\"$roam_seeds\" MAP_FRAMES=$map_frames BIG_FRAMES=$big_frames)"
-publish() {  # section file
-  python3 "$here/update_section.py" "$1" "$settings_line" <"$2"
-  cat "$2"
-}
 work="$(mktemp -d)"
 trap 'rm -rf "$work"' EXIT
-m() { python3 "$here/slam_metrics.py" "$@"; }
-mm() { python3 -c "print(f'{float($1)*1000:.1f}')"; }
-progress() { echo "[bench_atlas] $*" >&2; }
-
-run_eval() {  # dataset_dir out_dir [run options...]
-  local ds=$1 o=$2
-  shift 2
-  "$bin" run --dataset "$ds" --out "$o" --seed 42 --no-progress "$@" >"$o.log" 2>&1 ||
-    { cat "$o.log"; exit 1; }
-  "$bin" eval --gt "$ds/groundtruth.txt" --est "$o/trajectory.txt" --frames "$ds" \
-    --json "$o/eval.json" >/dev/null
-}
+bench_name=bench_atlas
+# shellcheck source=bench/bench_lib.sh
+source "$here/bench_lib.sh"
 
 out="$work/section_a.md"
 if want A; then

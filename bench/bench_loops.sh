@@ -34,26 +34,12 @@ presets="${PRESETS:-static walking_xyz walking_static walking_rpy walking_halfsp
 jobs="${JOBS:-2}"
 false_loop_m="${FALSE_LOOP_M:-4}"
 parts="${PARTS:-A B C D}"
-want() { [[ " $parts " == *" $1 "* ]]; }
 settings_line="bench/bench_loops.sh (SEEDS=\"$seeds\" LOOP_SEEDS=\"$loop_seeds\" LOOP_FRAMES=$loop_frames LONG_FRAMES=$long_frames DRIFT_BIASES=\"$biases\" KIDNAP_TARGETS=\"$kidnap_targets\")"
-publish() {  # section file
-  python3 "$here/update_section.py" "$1" "$settings_line" <"$2"
-  cat "$2"
-}
 work="$(mktemp -d)"
 trap 'rm -rf "$work"' EXIT
-m() { python3 "$here/slam_metrics.py" "$@"; }
-mm() { python3 -c "print(f'{float($1)*1000:.1f}')"; }
-progress() { echo "[bench_loops] $*" >&2; }
-
-run_eval() {  # dataset_dir out_dir [run options...]
-  local ds=$1 o=$2
-  shift 2
-  "$bin" run --dataset "$ds" --out "$o" --seed 42 --no-progress "$@" >"$o.log" 2>&1 ||
-    { cat "$o.log"; exit 1; }
-  "$bin" eval --gt "$ds/groundtruth.txt" --est "$o/trajectory.txt" --frames "$ds" \
-    --json "$o/eval.json" >/dev/null
-}
+bench_name=bench_loops
+# shellcheck source=bench/bench_lib.sh
+source "$here/bench_lib.sh"
 
 modes=("appearance (default)" "position, no vocabulary (earlier detector)" "loop closing off")
 mode_opts() {

@@ -1,0 +1,19 @@
+# Helpers shared by the whole-sequence benchmarks (sourced, not run). The sourcing script sets
+# here (bench/), bin (the detslam binary), parts, settings_line, work and bench_name first.
+want() { [[ " $parts " == *" $1 "* ]]; }
+publish() {  # section file
+  python3 "$here/update_section.py" "$1" "$settings_line" <"$2"
+  cat "$2"
+}
+m() { python3 "$here/slam_metrics.py" "$@"; }
+mm() { python3 -c "print(f'{float($1)*1000:.1f}')"; }
+progress() { echo "[$bench_name] $*" >&2; }
+
+run_eval() {  # dataset_dir out_dir [run options...]: sequential run, seed 42, then eval.json
+  local ds=$1 o=$2
+  shift 2
+  "$bin" run --dataset "$ds" --out "$o" --seed 42 --no-progress "$@" >"$o.log" 2>&1 ||
+    { cat "$o.log"; exit 1; }
+  "$bin" eval --gt "$ds/groundtruth.txt" --est "$o/trajectory.txt" --frames "$ds" \
+    --json "$o/eval.json" >/dev/null
+}
