@@ -24,7 +24,6 @@
 #include <nlohmann/json.hpp>
 #include <numeric>
 #include <opencv2/core/utility.hpp>
-#include <opencv2/imgproc.hpp>
 #include <set>
 #include <sstream>
 #include <string>
@@ -169,9 +168,7 @@ class PlaceBench {
 
 std::shared_ptr<FrameFeatures> PlaceBench::Extract(const SynthFrame& f) {
   const auto t0 = Clock::now();
-  cv::Mat gray, depth_m;
-  cv::cvtColor(f.bgr, gray, cv::COLOR_BGR2GRAY);
-  f.depth16.convertTo(depth_m, CV_32F, 1.0 / camera_.depth_map_factor);
+  const cv::Mat gray = f.Gray(), depth_m = f.DepthMetres(camera_.depth_map_factor);
   std::vector<cv::KeyPoint> keypoints;
   cv::Mat descriptors;
   extractor_.Extract(gray, cv::Mat(), &keypoints, &descriptors);

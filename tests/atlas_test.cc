@@ -5,8 +5,6 @@
 // black, as accurately as the uncovered twin's.
 #include <gtest/gtest.h>
 
-#include <opencv2/imgproc.hpp>
-
 #include "detslam/eval/ate.h"
 #include "detslam/pipeline/slam_system.h"
 #include "detslam/synth/sequence.h"
@@ -31,9 +29,7 @@ AtlasRun RunRoam(const SynthOptions& so) {
   AtlasRun run;
   for (int k = 0; k < seq.size(); ++k) {
     const SynthFrame f = seq.Render(k);
-    cv::Mat gray, depth;
-    cv::cvtColor(f.bgr, gray, cv::COLOR_BGR2GRAY);
-    f.depth16.convertTo(depth, CV_32F, 1.0 / seq.camera().depth_map_factor);
+    const cv::Mat gray = f.Gray(), depth = f.DepthMetres(seq.camera().depth_map_factor);
     const FrameReport r = slam.ProcessFrame(k, f.stamp, gray, depth);
     ++run.frames;
     run.black += so.Covered(k) ? 1 : 0;

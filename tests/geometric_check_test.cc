@@ -37,9 +37,8 @@ CheckCounts RunGeometricCheck(bool people, int frames) {
   const cv::Mat kernel = cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(11, 11));
   for (int k = 0; k < seq.size(); ++k) {
     const SynthFrame f = seq.Render(k);
-    cv::Mat gray, depth, on_person;
-    cv::cvtColor(f.bgr, gray, cv::COLOR_BGR2GRAY);
-    f.depth16.convertTo(depth, CV_32F, 1.0 / seq.camera().depth_map_factor);
+    const cv::Mat gray = f.Gray(), depth = f.DepthMetres(seq.camera().depth_map_factor);
+    cv::Mat on_person;
     cv::dilate(f.instance_mask > 0, on_person, kernel);
     FrameReport report;
     Frame frame = extractor.ExtractFrame(k, f.stamp, gray, depth, cv::Mat(), &report);

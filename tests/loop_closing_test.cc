@@ -6,8 +6,6 @@
 
 #include <algorithm>
 
-#include <opencv2/imgproc.hpp>
-
 #include "detslam/eval/ate.h"
 #include "detslam/pipeline/slam_system.h"
 #include "detslam/synth/sequence.h"
@@ -33,9 +31,7 @@ LoopRun RunLoopPreset(const SyntheticSequence& seq, bool loop_closing,
   LoopRun run;
   for (int k = 0; k < seq.size(); ++k) {
     const SynthFrame f = seq.Render(k);
-    cv::Mat gray, depth;
-    cv::cvtColor(f.bgr, gray, cv::COLOR_BGR2GRAY);
-    f.depth16.convertTo(depth, CV_32F, 1.0 / seq.camera().depth_map_factor);
+    const cv::Mat gray = f.Gray(), depth = f.DepthMetres(seq.camera().depth_map_factor);
     const FrameReport r = slam.ProcessFrame(k, f.stamp, gray, depth);
     run.tracked += r.tracking.pose_valid ? 1 : 0;
     if (r.loop_closed)

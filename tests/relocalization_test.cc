@@ -2,8 +2,6 @@
 // relocalise against the map when valid frames return, with poses consistent with before.
 #include <gtest/gtest.h>
 
-#include <opencv2/imgproc.hpp>
-
 #include "detslam/eval/ate.h"
 #include "detslam/pipeline/slam_system.h"
 #include "detslam/synth/sequence.h"
@@ -24,9 +22,7 @@ TEST(IntegrationRelocalization, RecoversAfterBlankFrames) {
   int tracked_after_gap = 0;
   for (int k = 0; k < seq.size(); ++k) {
     const SynthFrame f = seq.Render(k);
-    cv::Mat gray, depth;
-    cv::cvtColor(f.bgr, gray, cv::COLOR_BGR2GRAY);
-    f.depth16.convertTo(depth, CV_32F, 1.0 / seq.camera().depth_map_factor);
+    cv::Mat gray = f.Gray(), depth = f.DepthMetres(seq.camera().depth_map_factor);
     const bool blank = k >= 80 && k < 90;  // the sensor is covered: no texture, no depth
     if (blank) {
       gray.setTo(0);

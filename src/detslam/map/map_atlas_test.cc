@@ -3,21 +3,14 @@
 
 #include "detslam/core/check.h"
 #include "detslam/map/map.h"
+#include "detslam/map/map_test_util.h"
 
 namespace detslam {
 namespace {
 
-std::shared_ptr<FrameFeatures> Features(size_t n) {
-  auto f = std::make_shared<FrameFeatures>();
-  for (size_t i = 0; i < n; ++i) {
-    f->keypoints.emplace_back(static_cast<float>(10 * i), 20.0f, 31.0f, 0.0f, 1.0f, 0);
-    f->undist.emplace_back(10.0 * i, 20.0);
-    f->depth.push_back(1.0f);
-    f->u_right.push_back(0.0f);
-  }
-  f->descriptors = cv::Mat(static_cast<int>(n), 32, CV_8UC1, cv::Scalar(7));
-  return f;
-}
+using map_test::PartsOf;
+using map_test::RestoreLike;
+using map_test::RowFeatures;
 
 // Three keyframes of map `map_id`, each pair sharing `shared` landmarks; returns their ids.
 std::vector<KeyFrameId> AddChain(Map* map, int map_id, double x0, size_t shared) {
@@ -25,7 +18,7 @@ std::vector<KeyFrameId> AddChain(Map* map, int map_id, double x0, size_t shared)
   for (int k = 0; k < 3; ++k) {
     KeyFrame kf;
     kf.map_id = map_id;
-    kf.features = Features(2 * shared + 2);
+    kf.features = RowFeatures(2 * shared + 2, 7);
     kf.cam_from_world =
         Rigid3d(Eigen::Quaterniond(Eigen::AngleAxisd(0.1 * k, Eigen::Vector3d::UnitY())),
                 Eigen::Vector3d(-x0 - 0.2 * k, 0.05 * k, 0.0));
@@ -117,37 +110,26 @@ TEST(MapAtlas, RestoreRefusesMapsThatShareAnything) {
   Map map(ScaleInfo::Geometric(1.2, 8));
   AddChain(&map, 0, 0.0, 4);
   AddChain(&map, 1, 5.0, 4);
-  auto parts = [&] {
-    std::vector<KeyFrame> kfs;
-    for (const auto& [id, kf] : map.keyframes()) kfs.push_back(kf);
-    std::vector<Landmark> lms;
-    for (const auto& [id, lm] : map.landmarks()) lms.push_back(lm);
-    return std::make_pair(kfs, lms);
-  };
-  auto restore = [&](std::vector<KeyFrame> k, std::vector<Landmark> l) {
-    return Map::Restore(map.scale(), std::move(k), std::move(l), map.next_keyframe_id(),
-                        map.next_landmark_id());
-  };
   {
-    auto [k, l] = parts();
-    const Map restored = restore(k, l);
+    auto [k, l] = PartsOf(map);
+    const Map restored = RestoreLike(map, k, l);
     EXPECT_EQ(restored.map_roots(), map.map_roots());
     EXPECT_EQ(restored.NewMapId(), 2);
   }
   {
-    auto [k, l] = parts();
+    auto [k, l] = PartsOf(map);
     k[4].map_id = 0;  // covisible with keyframes of map 1, parent in map 1
-    EXPECT_THROW(restore(k, l), InputError);
+    EXPECT_THROW(RestoreLike(map, k, l), InputError);
   }
   {
-    auto [k, l] = parts();
+    auto [k, l] = PartsOf(map);
     k[3].parent = 0;  // map 1's root hung below map 0
-    EXPECT_THROW(restore(k, l), InputError);
+    EXPECT_THROW(RestoreLike(map, k, l), InputError);
   }
   {
-    auto [k, l] = parts();
+    auto [k, l] = PartsOf(map);
     l[0].observations[3] = 9;  // a landmark of map 0 also seen from map 1 (a free slot)
-    EXPECT_THROW(restore(k, l), InputError);
+    EXPECT_THROW(RestoreLike(map, k, l), InputError);
   }
 }
 

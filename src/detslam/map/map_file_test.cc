@@ -9,9 +9,13 @@
 
 #include "detslam/core/binary_io.h"
 #include "detslam/core/check.h"
+#include "detslam/map/map_test_util.h"
 
 namespace detslam {
 namespace {
+
+using map_test::PartsOf;
+using map_test::RestoreLike;
 
 std::string TempPath(const std::string& name) {
   return ::testing::TempDir() + "/detslam_map_file_" + name;
@@ -241,48 +245,37 @@ TEST(MapFile, DamageBehindAValidChecksumNeverCrashes) {
 TEST(MapRestore, RefusesPartsThatBreakTheMapsInvariants) {
   Fixture fx;
   const Map map = MakeMap(fx.camera);
-  auto parts = [&] {
-    std::vector<KeyFrame> kfs;
-    for (const auto& [id, kf] : map.keyframes()) kfs.push_back(kf);
-    std::vector<Landmark> lms;
-    for (const auto& [id, lm] : map.landmarks()) lms.push_back(lm);
-    return std::make_pair(kfs, lms);
-  };
-  auto restore = [&](std::vector<KeyFrame> k, std::vector<Landmark> l) {
-    return Map::Restore(map.scale(), std::move(k), std::move(l), map.next_keyframe_id(),
-                        map.next_landmark_id());
-  };
   {
-    auto [k, l] = parts();
-    EXPECT_NO_THROW(restore(k, l));
+    auto [k, l] = PartsOf(map);
+    EXPECT_NO_THROW(RestoreLike(map, k, l));
   }
   {
-    auto [k, l] = parts();
+    auto [k, l] = PartsOf(map);
     l[0].observations[1] = 0;  // keyframe 1 was erased
-    EXPECT_THROW(restore(k, l), InputError);
+    EXPECT_THROW(RestoreLike(map, k, l), InputError);
   }
   {
-    auto [k, l] = parts();
+    auto [k, l] = PartsOf(map);
     l[1].observations = l[0].observations;  // the same slots twice
-    EXPECT_THROW(restore(k, l), InputError);
+    EXPECT_THROW(RestoreLike(map, k, l), InputError);
   }
   {
-    auto [k, l] = parts();
+    auto [k, l] = PartsOf(map);
     k[0].covisibility[3] += 1;  // no matching reverse edge
-    EXPECT_THROW(restore(k, l), InputError);
+    EXPECT_THROW(RestoreLike(map, k, l), InputError);
   }
   {
-    auto [k, l] = parts();
+    auto [k, l] = PartsOf(map);
     k[1].parent = 1;  // erased
-    EXPECT_THROW(restore(k, l), InputError);
+    EXPECT_THROW(RestoreLike(map, k, l), InputError);
   }
   {
-    auto [k, l] = parts();
+    auto [k, l] = PartsOf(map);
     std::swap(k[0], k[1]);  // ids not ascending
-    EXPECT_THROW(restore(k, l), InputError);
+    EXPECT_THROW(RestoreLike(map, k, l), InputError);
   }
   {
-    auto [k, l] = parts();  // a next id that would make the first new keyframe allocate terabytes
+    auto [k, l] = PartsOf(map);  // a next id that would make the first new keyframe allocate terabytes
     EXPECT_THROW(Map::Restore(map.scale(), k, l, int64_t(1) << 40, map.next_landmark_id()),
                  InputError);
     EXPECT_THROW(Map::Restore(map.scale(), k, l, map.next_keyframe_id(), int64_t(1) << 40),

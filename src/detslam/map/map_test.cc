@@ -2,26 +2,16 @@
 
 #include <gtest/gtest.h>
 
+#include "detslam/map/map_test_util.h"
+
 namespace detslam {
 namespace {
 
 ScaleInfo TestScale() { return ScaleInfo::Geometric(1.2, 8); }
 
-std::shared_ptr<FrameFeatures> Features(size_t n, uint8_t fill) {
-  auto f = std::make_shared<FrameFeatures>();
-  for (size_t i = 0; i < n; ++i) {
-    f->keypoints.emplace_back(static_cast<float>(10 * i), 20.0f, 31.0f, 0.0f, 1.0f, 0);
-    f->undist.emplace_back(10.0 * i, 20.0);
-    f->depth.push_back(1.0f);
-    f->u_right.push_back(0.0f);
-  }
-  f->descriptors = cv::Mat(static_cast<int>(n), 32, CV_8UC1, cv::Scalar(fill));
-  return f;
-}
-
 KeyFrame MakeKeyFrame(size_t n, double x) {
   KeyFrame kf;
-  kf.features = Features(n, static_cast<uint8_t>(x * 10));
+  kf.features = map_test::RowFeatures(n, static_cast<uint8_t>(x * 10));
   kf.cam_from_world = Rigid3d(Eigen::Quaterniond::Identity(), Eigen::Vector3d(-x, 0, 0));
   return kf;
 }

@@ -1,5 +1,7 @@
 #include "detslam/synth/sequence.h"
 
+#include <opencv2/imgproc.hpp>
+
 #include <algorithm>
 #include <cmath>
 #include <map>
@@ -34,6 +36,18 @@ PinholeCamera SynthCamera() {
   cam.th_depth = 40.0;
   cam.rgb_order = true;
   return cam;
+}
+
+cv::Mat SynthFrame::Gray() const {
+  cv::Mat gray;
+  cv::cvtColor(bgr, gray, cv::COLOR_BGR2GRAY);
+  return gray;
+}
+
+cv::Mat SynthFrame::DepthMetres(double depth_map_factor) const {
+  cv::Mat depth_m;
+  depth16.convertTo(depth_m, CV_32F, 1.0 / depth_map_factor);
+  return depth_m;
 }
 
 double SynthFrame::Coverage() const {

@@ -43,6 +43,10 @@ struct SynthFrame {
   std::vector<SynthInstance> instances;  // visible people, by id
   // Fraction of pixels covered by moving objects.
   double Coverage() const;
+  // What the SLAM core reads from a dataset: 8-bit grey and depth in metres (CV_32F, 0 = missing),
+  // given the camera's depth_map_factor.
+  cv::Mat Gray() const;
+  cv::Mat DepthMetres(double depth_map_factor) const;
 };
 
 class SyntheticSequence {
