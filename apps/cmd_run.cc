@@ -2,7 +2,10 @@
 // thread per stage).
 #include <unistd.h>
 
+#include <atomic>
+#include <csignal>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <memory>
 
@@ -66,6 +69,46 @@ class ProgressBar {
   bool tty_;
 };
 
+// Ctrl-C (SIGINT) or SIGTERM during a run: the first asks the run to stop after the frame in
+// progress and write its outputs so far (run.json "interrupted": true; exit status 128 + signal);
+// a second one exits at once (outputs being written atomically keep their previous contents).
+std::atomic<bool> g_stop{false};
+volatile std::sig_atomic_t g_signal = 0;
+
+extern "C" void OnStopSignal(int sig) {
+  if (g_signal != 0) _exit(128 + sig);
+  g_signal = sig;
+  g_stop = true;
+  const char msg[] =
+      "\ndetslam: stopping after the current frame and writing the outputs so far (again to quit "
+      "at once)\n";
+  const ssize_t ignored = write(STDERR_FILENO, msg, sizeof(msg) - 1);
+  (void)ignored;
+}
+
+// Installs OnStopSignal for SIGINT and SIGTERM while it lives.
+class StopSignals {
+ public:
+  StopSignals() {
+    static_assert(std::atomic<bool>::is_always_lock_free, "set from a signal handler");
+    struct sigaction sa;
+    std::memset(&sa, 0, sizeof(sa));
+    sa.sa_handler = OnStopSignal;
+    sigemptyset(&sa.sa_mask);
+    sigaction(SIGINT, &sa, &old_int_);
+    sigaction(SIGTERM, &sa, &old_term_);
+  }
+  ~StopSignals() {
+    sigaction(SIGINT, &old_int_, nullptr);
+    sigaction(SIGTERM, &old_term_, nullptr);
+  }
+  StopSignals(const StopSignals&) = delete;
+  StopSignals& operator=(const StopSignals&) = delete;
+
+ private:
+  struct sigaction old_int_, old_term_;
+};
+
 void Run(const RunArgs& a) {
   namespace fs = std::filesystem;
   DatasetOptions dopt;
@@ -111,7 +154,13 @@ void Run(const RunArgs& a) {
   std::printf("detslam run (%s, segmenter %s): %zu frames from %s (settings: %s)\n", a.threaded ? "threaded" : "sequential", spec.c_str(), dataset.size(), dataset.dir().c_str(),
               settings.source.c_str());
   ProgressBar bar(!a.no_progress);
-  const RunSummary s = Run(dataset, settings, options, [&](size_t d, size_t t, const FrameReport& r) { bar.Update(d, t, r); }, segmenter.get());
+  options.stop = &g_stop;
+  RunSummary s;
+  {
+    const StopSignals signals;
+    s = Run(dataset, settings, options, [&](size_t d, size_t t, const FrameReport& r) { bar.Update(d, t, r); }, segmenter.get());
+  }
+  if (s.interrupted) std::printf("interrupted after %zu of %zu frames (signal %d): outputs of those frames written\n", s.frames, dataset.size(), static_cast<int>(g_signal));
   std::printf("tracked %zu/%zu frames (%.1f%%), %zu keyframes, %zu map points, %zu relocalisations, %zu loops closed\n",
               s.tracked, s.frames, 100.0 * s.TrackedFraction(), s.keyframes, s.landmarks, s.relocalizations, s.loops);
   if (s.maps_started > 1 || s.maps_left > 1) {
@@ -129,6 +178,10 @@ void Run(const RunArgs& a) {
   if (!dataset.groundtruth_path().empty()) {
     std::printf("evaluate: detslam eval --gt %s --est %s --frames %s\n", dataset.groundtruth_path().c_str(),
                 (out / "trajectory.txt").c_str(), dataset.dir().c_str());
+  }
+  if (s.interrupted) {
+    std::fflush(stdout);
+    throw CommandFailed("run interrupted (outputs written for the frames processed)", 128 + static_cast<int>(g_signal));
   }
 }
 

@@ -17,9 +17,7 @@ using testing::ReadFileBytes;
 using testing::RunCli;
 
 TEST(IntegrationReport, RunThenReportWithAccuracyAndPerFramePlots) {
-  const fs::path dir = fs::temp_directory_path() / "detslam_it_report";
-  fs::remove_all(dir);
-  fs::create_directories(dir);
+  const fs::path dir = testing::TempDir("report");
   const fs::path seq = dir / "seq", out = dir / "out", log = dir / "log.txt";
   ASSERT_EQ(
       RunCli("synth --preset walking_xyz --seed 1 --frames 40 --out '" + seq.string() + "'", log),

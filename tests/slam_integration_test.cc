@@ -2,8 +2,6 @@
 // truth, asserting tracked fraction and accuracy, and determinism of sequential runs.
 #include <gtest/gtest.h>
 
-#include <unistd.h>
-
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -20,6 +18,7 @@
 #include "detslam/place/default_vocabulary.h"
 #include "detslam/segmentation/segmenter_factory.h"
 #include "detslam/synth/writer.h"
+#include "support/cli_runner.h"
 #include "support/shared_data.h"
 
 namespace detslam {
@@ -27,13 +26,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::string TempDir(const std::string& name) {
-  // Per process, so that two test runs on one machine do not share folders.
-  const fs::path p = fs::temp_directory_path() / ("detslam_it_" + std::to_string(::getpid()) + "_" + name);
-  fs::remove_all(p);
-  fs::create_directories(p);
-  return p.string();
-}
+using testing::TempDir;
 
 struct SlamRun {
   RunSummary summary;

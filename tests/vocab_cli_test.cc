@@ -1,8 +1,6 @@
 // `detslam vocab train|info` end to end on a few generated images, and its errors on bad input.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
-#include <unistd.h>
-
 #include <filesystem>
 #include <fstream>
 #include <opencv2/imgcodecs.hpp>
@@ -21,9 +19,7 @@ using testing::ReadFileBytes;
 using testing::RunCli;
 
 TEST(IntegrationVocabCli, TrainThenInfoDeterministic) {
-  const fs::path dir =
-      fs::temp_directory_path() / ("detslam_it_vocab_" + std::to_string(::getpid()));
-  fs::remove_all(dir);
+  const fs::path dir = testing::TempDir("vocab");
   fs::create_directories(dir / "images");
   cv::RNG rng(3);
   for (int i = 0; i < 5; ++i) {  // blocky random texture: plenty of FAST corners
@@ -71,11 +67,8 @@ TEST(IntegrationVocabCli, TrainThenInfoDeterministic) {
 // `detslam run` with a vocabulary it cannot use stops with the file named, before writing outputs;
 // with none it runs without place recognition and says so in run.json.
 TEST(IntegrationVocabCli, RunNamesABadVocabularyAndRunsWithNone) {
-  const fs::path dir =
-      fs::temp_directory_path() / ("detslam_it_vocab_run_" + std::to_string(::getpid()));
-  fs::remove_all(dir);
+  const fs::path dir = testing::TempDir("vocab_run");
   const fs::path log = dir / "log.txt";
-  fs::create_directories(dir);
   ASSERT_EQ(RunCli("synth --preset static --frames 3 --out '" + (dir / "seq").string() + "'", log),
             0)
       << ReadFileBytes(log);
@@ -110,10 +103,7 @@ TEST(DataVocabulary, ShippedFileIsReproducible) {
     if (testing::InCi()) FAIL() << why;
     GTEST_SKIP() << why;
   }
-  const fs::path dir =
-      fs::temp_directory_path() / ("detslam_data_vocab_" + std::to_string(::getpid()));
-  fs::remove_all(dir);
-  fs::create_directories(dir);
+  const fs::path dir = testing::TempDir("data_vocab");
   const fs::path log = dir / "log.txt", out = dir / "rebuilt.dslvoc";
   ASSERT_EQ(RunCli("vocab train --images '" + sources.string() +
                        "' --k 10 --levels 5 --features 8000 --seed 1 --out '" + out.string() + "'",

@@ -1,8 +1,12 @@
 // Running the built `detslam` command from tests: its output goes to a log file the test reads.
 #pragma once
 
+#include <sys/types.h>
+
+#include <chrono>
 #include <filesystem>
 #include <string>
+#include <vector>
 
 namespace detslam::testing {
 
@@ -13,6 +17,32 @@ int RunCommand(const std::string& binary, const std::string& args,
 
 // The whole file as bytes ("" if it cannot be read).
 std::string ReadFileBytes(const std::filesystem::path& path);
+
+// A fresh, empty folder for one test, per process (two test runs on one machine never share it).
+std::string TempDir(const std::string& name);
+
+// A command started in the background (no shell), stdout and stderr into a log file, for tests
+// that signal it while it runs. The destructor kills it if it still runs.
+class ChildProcess {
+ public:
+  // Throws std::runtime_error if it cannot be started.
+  ChildProcess(const std::string& binary, const std::vector<std::string>& args,
+               const std::filesystem::path& log);
+  ~ChildProcess();
+  ChildProcess(const ChildProcess&) = delete;
+  ChildProcess& operator=(const ChildProcess&) = delete;
+
+  void Signal(int sig) const;
+  // Waits until the log contains `text` or the process exits (false) or `timeout` passes (false).
+  bool WaitForLog(const std::string& text, std::chrono::milliseconds timeout);
+  // Waits for the exit: its status (128 + signal if a signal ended it), or -1 after `timeout`.
+  int Wait(std::chrono::milliseconds timeout);
+
+ private:
+  pid_t pid_ = -1;
+  int status_ = -1;  // once exited
+  std::filesystem::path log_;
+};
 
 #ifdef DETSLAM_CLI_PATH
 // The built `detslam` command (targets that define DETSLAM_CLI_PATH).

@@ -4,8 +4,10 @@
 
 #include <algorithm>
 #include <chrono>
+#include <condition_variable>
 #include <filesystem>
 #include <functional>
+#include <mutex>
 #include <nlohmann/json.hpp>
 #include <numeric>
 #include <thread>
@@ -91,6 +93,7 @@ void WriteOutputs(const RgbdDataset& dataset, const Settings& settings, const Ru
               {"ini_th_fast", options.slam.orb.ini_th_fast},
               {"min_th_fast", options.slam.orb.min_th_fast}};
   j["seed"] = options.slam.tracker.seed;
+  j["interrupted"] = summary.interrupted;
   j["frames"] = summary.frames;
   j["frames_tracked"] = summary.tracked;
   j["tracked_fraction"] = summary.TrackedFraction();
@@ -217,6 +220,48 @@ SlamOptions SlamOptionsFromSettings(const Settings& settings, uint64_t seed) {
 
 namespace {
 
+bool StopRequested(const RunOptions& options) {
+  return options.stop != nullptr && options.stop->load();
+}
+
+// While it lives, watches RunOptions::stop (every 20 ms) and, once it is set, interrupts the SLAM
+// system (a global BA running in the calling thread or its own stops) and calls `on_stop` (e.g.
+// closing the queues between threaded stages). Does nothing without a stop flag.
+class StopWatcher {
+ public:
+  StopWatcher(const RunOptions& options, SlamSystem* slam, std::function<void()> on_stop = {}) {
+    if (options.stop == nullptr) return;
+    thread_ = std::thread([this, flag = options.stop, slam, on_stop = std::move(on_stop)] {
+      std::unique_lock<std::mutex> lock(mutex_);
+      while (!done_) {
+        if (flag->load()) {
+          slam->Interrupt();
+          if (on_stop) on_stop();
+          return;
+        }
+        wake_.wait_for(lock, std::chrono::milliseconds(20));
+      }
+    });
+  }
+  ~StopWatcher() {
+    if (!thread_.joinable()) return;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      done_ = true;
+    }
+    wake_.notify_all();
+    thread_.join();
+  }
+  StopWatcher(const StopWatcher&) = delete;
+  StopWatcher& operator=(const StopWatcher&) = delete;
+
+ private:
+  std::mutex mutex_;
+  std::condition_variable wake_;
+  bool done_ = false;
+  std::thread thread_;
+};
+
 // Collects per-frame reports and turns them into the summary and the output files.
 class RunRecorder {
  public:
@@ -253,6 +298,10 @@ class RunRecorder {
     if (segmenter != nullptr) summary_.segmenter = segmenter->name();
     summary_.segmentation = ComputeErrorStats(seg_);
     slam.WaitForGlobalBundleAdjustment();
+    summary_.interrupted = StopRequested(options);  // also while the last global BA ran
+    if (summary_.interrupted)
+      spdlog::warn("run interrupted after {} of {} frames: writing the outputs so far",
+                   summary_.frames, total_);
     summary_.loops = static_cast<size_t>(slam.loops_closed());
     summary_.maps_merged = slam.maps_merged();
     summary_.loop_records = slam.loops();
@@ -334,7 +383,8 @@ RunSummary RunSequential(const RgbdDataset& dataset, const Settings& settings,
   const size_t n = FrameCount(dataset, options);
   RunRecorder recorder(n, progress);
   recorder.LoadMap(options, &slam);
-  for (size_t i = 0; i < n; ++i) {
+  const StopWatcher watcher(options, &slam);
+  for (size_t i = 0; i < n && !StopRequested(options); ++i) {
     const LoadedFrame loaded = LoadAndSegment(dataset, settings, i, &slam);
     FrameReport report;
     Frame frame = Extract(slam, dataset, loaded, &report);
@@ -362,15 +412,18 @@ RunSummary RunThreaded(const RgbdDataset& dataset, const Settings& settings,
   BoundedQueue<LoadedFrame> loaded(options.queue_capacity);
   BoundedQueue<Extracted> extracted(options.queue_capacity);
   BoundedQueue<KeyFrameId> keyframes(8);
-  StageThreads stages([&] {
+  const auto close_queues = [&] {
     loaded.Close();
     extracted.Close();
     keyframes.Close();
-  });
+  };
+  StageThreads stages(close_queues);
+  // A stop drops the frames and keyframes still queued: every stage ends after its current item.
+  const StopWatcher watcher(options, &slam, close_queues);
   stages.Start(
       "loading",
       [&] {
-        for (size_t i = 0; i < n; ++i) {
+        for (size_t i = 0; i < n && !StopRequested(options); ++i) {
           if (!loaded.Push(LoadAndSegment(dataset, settings, i, &slam))) break;
         }
       },
@@ -379,6 +432,7 @@ RunSummary RunThreaded(const RgbdDataset& dataset, const Settings& settings,
       "extraction",
       [&] {
         while (std::optional<LoadedFrame> f = loaded.Pop()) {
+          if (StopRequested(options)) break;
           Extracted e;
           e.frame = Extract(slam, dataset, *f, &e.report);
           if (!extracted.Push(std::move(e))) break;
@@ -388,6 +442,7 @@ RunSummary RunThreaded(const RgbdDataset& dataset, const Settings& settings,
   if (options.mapping_thread) {
     stages.Start("local mapping", [&] {
       while (std::optional<KeyFrameId> kf = keyframes.Pop()) {
+        if (StopRequested(options)) break;  // the keyframe stays in the map, not locally mapped
         FrameReport unused;
         slam.MapKeyFrame(*kf, &unused);
       }
@@ -397,6 +452,7 @@ RunSummary RunThreaded(const RgbdDataset& dataset, const Settings& settings,
       "tracking",
       [&] {
         while (std::optional<Extracted> e = extracted.Pop()) {
+          if (StopRequested(options)) break;
           const KeyFrameId kf = slam.TrackFrame(std::move(e->frame), &e->report);
           if (kf != kNoKeyFrame) {
             if (!options.mapping_thread) {

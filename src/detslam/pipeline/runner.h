@@ -1,8 +1,10 @@
 // Runs the SLAM system over a whole RGB-D dataset and writes the outputs:
 // trajectory.txt (TUM format, every tracked frame), keyframes.txt, map.ply (landmarks) and
-// run.json (settings, timings, counts). All outputs are written atomically at the end.
+// run.json (settings, timings, counts). All outputs are written atomically at the end, also when
+// the run is stopped early (RunOptions::stop).
 #pragma once
 
+#include <atomic>
 #include <functional>
 #include <string>
 #include <vector>
@@ -23,6 +25,10 @@ struct RunOptions {
   size_t queue_capacity = 4;    // frames buffered between the threaded stages
   std::string save_map;         // write the final map to this map file (empty: none)
   std::string load_map;         // start from the map in this map file (empty: a new map)
+  // When *stop becomes true (e.g. set by a signal handler): the frame in progress is finished,
+  // frames still queued are dropped, a running global BA stops after its current iteration, and
+  // the outputs of the frames processed so far are written (RunSummary::interrupted).
+  const std::atomic<bool>* stop = nullptr;
   SlamOptions slam;
 };
 
@@ -31,8 +37,9 @@ struct RunOptions {
 SlamOptions SlamOptionsFromSettings(const Settings& settings, uint64_t seed);
 
 struct RunSummary {
-  size_t frames = 0;
+  size_t frames = 0;  // processed (fewer than the dataset's when interrupted or max_frames)
   size_t tracked = 0;
+  bool interrupted = false;  // stopped early by RunOptions::stop
   size_t keyframes = 0;
   size_t landmarks = 0;
   size_t relocalizations = 0;

@@ -71,6 +71,11 @@ void SlamSystem::WaitForGlobalBundleAdjustment() {
   if (global_ba_.joinable()) global_ba_.join();
 }
 
+void SlamSystem::Interrupt() {
+  interrupted_ = true;  // before the stop flag: see where a global BA thread starts
+  stop_global_ba_ = true;
+}
+
 std::vector<LoopRecord> SlamSystem::loops() const {
   const MapStore::ReadAccess map = store_.Read();
   return loops_;
@@ -102,7 +107,7 @@ void SlamSystem::MapKeyFrame(KeyFrameId kf, FrameReport* report) {
                         report->loop_candidate_frame, loop.inliers, loop.agreeing,
                         loop.correction_m, loop.merged, loop.merged_from, loop.merged_into});
       ++loop_generation_;
-      global_ba = options_.loop.global_ba_iterations > 0;
+      global_ba = options_.loop.global_ba_iterations > 0 && !interrupted_;
     }
   }
   if (global_ba) {
@@ -131,6 +136,7 @@ void SlamSystem::MapKeyFrame(KeyFrameId kf, FrameReport* report) {
       WaitForGlobalBundleAdjustment();
       stop_global_ba_ = false;
       global_ba_running_ = true;
+      if (interrupted_) stop_global_ba_ = true;  // Interrupt() came after the check above
       global_ba_ = std::thread(run);
     } else {
       run();

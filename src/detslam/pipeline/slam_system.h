@@ -149,6 +149,9 @@ class SlamSystem {
   // before the trajectory is written. The destructor stops it instead (after its current
   // iteration, progress kept).
   void WaitForGlobalBundleAdjustment();
+  // Thread-safe: a running global BA stops after its current iteration (progress kept) and no new
+  // one starts; for a run that is being stopped (e.g. Ctrl-C).
+  void Interrupt();
   // Global bundle adjustments started, and those stopped early because a newer loop was closed
   // while they ran (their solution is discarded: it predates that loop's correction).
   int global_ba_runs() const;
@@ -194,6 +197,7 @@ class SlamSystem {
   int loop_generation_ = 0;  // loops corrected so far (a global BA started before one is stale)
   std::atomic<bool> stop_global_ba_{false};     // asks the running global BA to stop
   std::atomic<bool> global_ba_running_{false};  // a global BA thread has not finished yet
+  std::atomic<bool> interrupted_{false};        // Interrupt(): no new global BA
   std::atomic<int> global_ba_runs_{0};
   std::atomic<int> global_ba_stopped_{0};
 };
