@@ -160,6 +160,7 @@ void Run(const RunArgs& a) {
     const StopSignals signals;
     s = Run(dataset, settings, options, [&](size_t d, size_t t, const FrameReport& r) { bar.Update(d, t, r); }, segmenter.get());
   }
+  if (s.skipped > 0) std::printf("skipped %zu frames whose images could not be read (run.json skipped_frames)\n", s.skipped);
   if (s.interrupted) std::printf("interrupted after %zu of %zu frames (signal %d): outputs of those frames written\n", s.frames, dataset.size(), static_cast<int>(g_signal));
   std::printf("tracked %zu/%zu frames (%.1f%%), %zu keyframes, %zu map points, %zu relocalisations, %zu loops closed\n",
               s.tracked, s.frames, 100.0 * s.TrackedFraction(), s.keyframes, s.landmarks, s.relocalizations, s.loops);

@@ -1,6 +1,7 @@
 // The `detslam` command: subcommands run, eval, synth, segment, report, settings, vocab (--help).
 #include <spdlog/spdlog.h>
 
+#include <csignal>
 #include <exception>
 #include <iostream>
 
@@ -8,6 +9,9 @@
 #include "detslam/core/check.h"
 
 int main(int argc, char** argv) {
+  // A write beyond the file size limit (ulimit -f) then fails with an error the atomic writes
+  // report ("disk full?") instead of killing the process.
+  std::signal(SIGXFSZ, SIG_IGN);
   CLI::App app{"detslam: RGB-D SLAM for dynamic scenes (Det-SLAM method)"};
   app.require_subcommand(1);
   bool verbose = false;

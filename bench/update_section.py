@@ -1,9 +1,10 @@
 #!/usr/bin/env python3
-"""Replaces one named section of docs/BENCHMARKS.md with markdown read from stdin.
+"""Replaces one named section of docs/BENCHMARKS.md (or docs/RELIABILITY.md) with markdown read
+from stdin.
 
-Benchmark commands pipe their own output here, so every number in docs/BENCHMARKS.md was written
-by the command that measured it. The section is stamped with the machine, the date and the command.
-Usage: some_benchmark | bench/update_section.py NAME "command line that produced it"
+Benchmark commands pipe their own output here, so every number in those files was written by the
+command that measured it. The section is stamped with the machine, the date and the command.
+Usage: some_benchmark | bench/update_section.py NAME "command line that produced it" [RELIABILITY]
 """
 import datetime
 import os
@@ -42,10 +43,17 @@ def commit() -> str:
                                 cwd=os.path.dirname(os.path.abspath(__file__))).stdout
         # The benchmark file and the README summary do not make the measured code dirty.
         dirty = [l for l in status.splitlines()
-                 if l.strip() and not l.endswith(("docs/BENCHMARKS.md", "README.md"))]
+                 if l.strip() and not l.endswith(DOCS_AND_README)]
         return out.stdout.strip() + (" (uncommitted changes)" if dirty else "")
     except (OSError, subprocess.CalledProcessError):
         return "unknown"
+
+
+DOCS = {  # name -> (file under docs/, its title and opening line)
+    "BENCHMARKS": ("BENCHMARKS.md", "# Benchmarks"),
+    "RELIABILITY": ("RELIABILITY.md", "# Reliability"),
+}
+DOCS_AND_README = tuple("docs/" + f for f, _ in DOCS.values()) + ("README.md",)
 
 
 def replace_marked_block(text: str, name: str, content: str) -> str:
@@ -73,18 +81,23 @@ def main() -> int:
         print(__doc__, file=sys.stderr)
         return 2
     name, command = sys.argv[1], sys.argv[2]
+    doc = sys.argv[3] if len(sys.argv) > 3 else "BENCHMARKS"
+    if doc not in DOCS:
+        print(f"unknown document {doc!r} (one of {', '.join(DOCS)})", file=sys.stderr)
+        return 2
+    filename, title = DOCS[doc]
     if not re.fullmatch(r"[a-z0-9_-]+", name):
         print(f"bad section name {name!r}", file=sys.stderr)
         return 2
     body = sys.stdin.read().rstrip() + "\n"
     root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-    path = os.path.join(root, "docs", "BENCHMARKS.md")
+    path = os.path.join(root, "docs", filename)
     text = ""
     if os.path.exists(path):
         with open(path) as f:
             text = f.read()
-    if not text.startswith("# Benchmarks"):
-        text = ("# Benchmarks\n\nEvery section below is written by the command named in it "
+    if not text.startswith(title):
+        text = (f"{title}\n\nEvery section below is written by the command named in it "
                 "(never by hand); rerun that command to refresh it.\n")
     load = " ".join(f"{x:.2f}" for x in os.getloadavg())
     stamp = (f"_Written by `{command}` on {datetime.datetime.now().strftime('%Y-%m-%d %H:%M')}; "

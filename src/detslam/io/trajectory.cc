@@ -25,8 +25,15 @@ Trajectory ReadTumTrajectory(const std::string& path) {
     }
     double v[7];
     for (int k = 0; k < 7; ++k) v[k] = ParseDoubleField(path, line_no, fields[k + 1]);
+    // Beyond 1000 km a value is no camera position, and its squares overflow the ATE alignment.
+    constexpr double kMaxPositionM = 1e6;
+    for (int k = 0; k < 3; ++k) {
+      if (std::abs(v[k]) > kMaxPositionM)
+        throw InputError(path, line_no, "position '" + fields[k + 1] + "' beyond 10^6 m");
+    }
     const Eigen::Quaterniond q(v[6], v[3], v[4], v[5]);
     if (q.norm() < 1e-9) throw InputError(path, line_no, "zero quaternion");
+    if (!std::isfinite(q.norm())) throw InputError(path, line_no, "quaternion too large");
     p.world_from_cam = Rigid3d(q, Eigen::Vector3d(v[0], v[1], v[2]));
     out.push_back(p);
   });

@@ -50,6 +50,22 @@ TEST(Trajectory, ShortLineAndMissingFileAreErrors) {
   EXPECT_THROW(ReadTumTrajectory(TempPath("does_not_exist.txt")), InputError);
 }
 
+TEST(Trajectory, NonFiniteAndHugeValuesNameFileAndLine) {
+  const std::string path = TempPath("huge.txt");
+  for (const std::string bad : {"2.0 nan 0 0 0 0 0 1", "2.0 0 inf 0 0 0 0 1", "2.0 0 0 2e6 0 0 0 1",
+                                "2.0 0 0 0 1e300 1e300 0 1", "2.0 0 0 0 0 0 0 0"}) {
+    WriteText(path, "1.0 0 0 0 0 0 0 1\n" + bad + "\n");
+    try {
+      ReadTumTrajectory(path);
+      ADD_FAILURE() << "no error for " << bad;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(path + ":2"), std::string::npos) << e.what();
+    }
+  }
+  WriteText(path, "1.0 0 0 0 0 0 0 1\n2.0 0 0 9e5 0 0 0 1\n");  // large but possible
+  EXPECT_EQ(ReadTumTrajectory(path).size(), 2u);
+}
+
 TEST(Trajectory, AcceptsCommasAndTabs) {
   const std::string path = TempPath("commas.txt");
   WriteText(path, "1.0,1,2,3,0,0,0,1\n2.0\t1\t2\t3\t0\t0\t0\t2\n");

@@ -6,6 +6,7 @@
 #include <chrono>
 #include <condition_variable>
 #include <filesystem>
+#include <fstream>
 #include <functional>
 #include <mutex>
 #include <nlohmann/json.hpp>
@@ -13,6 +14,7 @@
 #include <thread>
 
 #include "detslam/core/atomic_file.h"
+#include "detslam/core/check.h"
 #include "detslam/io/ply.h"
 #include "detslam/pipeline/bounded_queue.h"
 #include "detslam/pipeline/settings_keys.h"
@@ -95,6 +97,11 @@ void WriteOutputs(const RgbdDataset& dataset, const Settings& settings, const Ru
   j["seed"] = options.slam.tracker.seed;
   j["interrupted"] = summary.interrupted;
   j["frames"] = summary.frames;
+  nlohmann::json skipped = nlohmann::json::array();
+  for (const FrameReport& r : summary.reports) {
+    if (!r.skipped.empty()) skipped.push_back({{"frame", r.index}, {"reason", r.skipped}});
+  }
+  j["skipped_frames"] = skipped;
   j["frames_tracked"] = summary.tracked;
   j["tracked_fraction"] = summary.TrackedFraction();
   j["keyframes"] = summary.keyframes;
@@ -182,7 +189,7 @@ void WriteOutputs(const RgbdDataset& dataset, const Settings& settings, const Ru
                          {"final_map", r.tracking.pose_valid && fm != final_map.end() ? fm->second
                                                                                       : -1},
                          {"stamp", r.stamp.Seconds()},
-                         {"state", ToString(r.tracking.state)},
+                         {"state", r.skipped.empty() ? ToString(r.tracking.state) : "skipped"},
                          {"tracked", r.tracking.pose_valid},
                          {"method", r.tracking.method},
                          {"inliers", r.tracking.num_inliers},
@@ -219,6 +226,32 @@ SlamOptions SlamOptionsFromSettings(const Settings& settings, uint64_t seed) {
 }
 
 namespace {
+
+// Creates `dir` and checks that a file can be written in it, so that a run whose outputs could not
+// be written fails before its first frame rather than after its last.
+void CheckWritableFolder(const std::string& dir, const std::string& what) {
+  namespace fs = std::filesystem;
+  const fs::path folder = dir.empty() ? fs::path(".") : fs::path(dir);
+  std::error_code ec;
+  fs::create_directories(folder, ec);
+  if (ec) throw InputError(folder.string(), 0, "cannot create the " + what + ": " + ec.message());
+  const fs::path probe = folder / ".detslam_write_probe";
+  {
+    std::ofstream out(probe, std::ios::binary | std::ios::trunc);
+    out << "probe\n";
+    out.flush();
+    if (!out) throw InputError(folder.string(), 0, "cannot write in the " + what);
+  }
+  fs::remove(probe, ec);
+}
+
+void CheckOutputs(const RunOptions& options) {
+  CheckWritableFolder(options.out_dir, "output folder");
+  if (!options.save_map.empty()) {
+    CheckWritableFolder(std::filesystem::path(options.save_map).parent_path().string(),
+                        "folder of the map file (--save-map)");
+  }
+}
 
 bool StopRequested(const RunOptions& options) {
   return options.stop != nullptr && options.stop->load();
@@ -281,6 +314,24 @@ class RunRecorder {
     if (progress_) progress_(summary_.frames, total_, r);
   }
 
+  // A frame whose images could not be read: no pose, listed in run.json (skipped_frames).
+  void AddSkipped(int64_t index, Timestamp stamp, const std::string& reason) {
+    constexpr size_t kWarnings = 10;
+    if (summary_.skipped < kWarnings) {
+      spdlog::warn("frame {} skipped: {}", index, reason);
+    } else if (summary_.skipped == kWarnings) {
+      spdlog::warn("further unreadable frames are skipped without a warning (all in run.json)");
+    }
+    ++summary_.skipped;
+    ++summary_.frames;
+    FrameReport r;
+    r.index = index;
+    r.stamp = stamp;
+    r.skipped = reason;
+    summary_.reports.push_back(r);
+    if (progress_) progress_(summary_.frames, total_, r);
+  }
+
   // Starts `slam` from options.load_map (if any); recorded in the summary.
   void LoadMap(const RunOptions& options, SlamSystem* slam) {
     if (options.load_map.empty()) return;
@@ -296,6 +347,10 @@ class RunRecorder {
                     SlamSystem& slam, std::chrono::steady_clock::time_point start,
                     const Segmenter* segmenter) {
     if (segmenter != nullptr) summary_.segmenter = segmenter->name();
+    if (summary_.frames > 0 && summary_.skipped == summary_.frames) {
+      throw InputError("no frame of " + dataset.dir() + " could be read; the first: " +
+                       summary_.reports.front().skipped);
+    }
     summary_.segmentation = ComputeErrorStats(seg_);
     slam.WaitForGlobalBundleAdjustment();
     summary_.interrupted = StopRequested(options);  // also while the last global BA ran
@@ -342,6 +397,7 @@ namespace {
 
 struct LoadedFrame {
   int64_t index = 0;
+  std::string unreadable;  // why its images could not be read (then nothing else is set)
   RgbdImages images;
   std::vector<Instance> instances;
   bool segmented = false;
@@ -352,7 +408,12 @@ LoadedFrame LoadAndSegment(const RgbdDataset& dataset, const Settings& settings,
                            SlamSystem* slam) {
   LoadedFrame f;
   f.index = static_cast<int64_t>(i);
-  f.images = dataset.Load(i, settings.camera);
+  try {
+    f.images = dataset.Load(i, settings.camera);
+  } catch (const InputError& e) {
+    f.unreadable = e.what();
+    return f;
+  }
   SegmenterInput in;
   in.index = f.index;
   in.stamp = dataset.frame(i).rgb_stamp;
@@ -379,6 +440,7 @@ RunSummary RunSequential(const RgbdDataset& dataset, const Settings& settings,
                          const RunOptions& options, const ProgressFn& progress,
                          Segmenter* segmenter) {
   const auto start = std::chrono::steady_clock::now();
+  CheckOutputs(options);
   SlamSystem slam(settings.camera, options.slam, segmenter);
   const size_t n = FrameCount(dataset, options);
   RunRecorder recorder(n, progress);
@@ -386,6 +448,10 @@ RunSummary RunSequential(const RgbdDataset& dataset, const Settings& settings,
   const StopWatcher watcher(options, &slam);
   for (size_t i = 0; i < n && !StopRequested(options); ++i) {
     const LoadedFrame loaded = LoadAndSegment(dataset, settings, i, &slam);
+    if (!loaded.unreadable.empty()) {
+      recorder.AddSkipped(loaded.index, dataset.frame(i).rgb_stamp, loaded.unreadable);
+      continue;
+    }
     FrameReport report;
     Frame frame = Extract(slam, dataset, loaded, &report);
     const KeyFrameId kf = slam.TrackFrame(std::move(frame), &report);
@@ -399,6 +465,7 @@ RunSummary RunThreaded(const RgbdDataset& dataset, const Settings& settings,
                        const RunOptions& options, const ProgressFn& progress,
                        Segmenter* segmenter) {
   const auto start = std::chrono::steady_clock::now();
+  CheckOutputs(options);
   SlamOptions slam_options = options.slam;
   slam_options.global_ba_thread = options.mapping_thread;  // nothing waits for it then
   SlamSystem slam(settings.camera, slam_options, segmenter);
@@ -434,7 +501,12 @@ RunSummary RunThreaded(const RgbdDataset& dataset, const Settings& settings,
         while (std::optional<LoadedFrame> f = loaded.Pop()) {
           if (StopRequested(options)) break;
           Extracted e;
-          e.frame = Extract(slam, dataset, *f, &e.report);
+          if (!f->unreadable.empty()) {
+            e.report.index = f->index;
+            e.report.skipped = f->unreadable;
+          } else {
+            e.frame = Extract(slam, dataset, *f, &e.report);
+          }
           if (!extracted.Push(std::move(e))) break;
         }
       },
@@ -453,6 +525,12 @@ RunSummary RunThreaded(const RgbdDataset& dataset, const Settings& settings,
       [&] {
         while (std::optional<Extracted> e = extracted.Pop()) {
           if (StopRequested(options)) break;
+          if (!e->report.skipped.empty()) {
+            recorder.AddSkipped(e->report.index,
+                                dataset.frame(static_cast<size_t>(e->report.index)).rgb_stamp,
+                                e->report.skipped);
+            continue;
+          }
           const KeyFrameId kf = slam.TrackFrame(std::move(e->frame), &e->report);
           if (kf != kNoKeyFrame) {
             if (!options.mapping_thread) {

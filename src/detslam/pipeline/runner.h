@@ -40,6 +40,7 @@ struct RunSummary {
   size_t frames = 0;  // processed (fewer than the dataset's when interrupted or max_frames)
   size_t tracked = 0;
   bool interrupted = false;  // stopped early by RunOptions::stop
+  size_t skipped = 0;        // frames whose images could not be read (FrameReport::skipped)
   size_t keyframes = 0;
   size_t landmarks = 0;
   size_t relocalizations = 0;
@@ -66,6 +67,10 @@ using ProgressFn = std::function<void(size_t done, size_t total, const FrameRepo
 
 // Sequential mode: one frame at a time through extraction, tracking and local mapping.
 // Deterministic for a given dataset, settings and seed.
+// In every mode a frame whose images cannot be read (RgbdDataset::Load throws InputError: corrupt
+// or missing file, wrong type or size) is skipped with a warning and listed in run.json
+// (skipped_frames); the run goes on. When no frame at all can be read the run throws InputError
+// with the first frame's reason and writes nothing.
 RunSummary RunSequential(const RgbdDataset& dataset, const Settings& settings,
                          const RunOptions& options, const ProgressFn& progress = nullptr,
                          Segmenter* segmenter = nullptr);

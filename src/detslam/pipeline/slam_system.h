@@ -90,6 +90,9 @@ struct FrameReport {
   bool maps_merged = false;                 //   it was a merge of two maps
   int num_keypoints = 0;
   FrameTimings timings;
+  // Why the frame was skipped (its images could not be read: corrupt, wrong type or size, gone);
+  // empty for a processed frame. A skipped frame has no pose and is not seen by tracking.
+  std::string skipped;
 };
 
 // The SLAM stages of one sequence. It starts no thread: the runner calls ExtractFrame,

@@ -1,0 +1,142 @@
+#!/usr/bin/env bash
+# Reliability benchmark (issue: never crash, never lose work). Writes docs/RELIABILITY.md:
+#  S. sanitizers: scripts/sanitize.sh address (AddressSanitizer + UndefinedBehaviorSanitizer +
+#     LeakSanitizer: every unit test and an integration set) and scripts/sanitize.sh thread
+#     (ThreadSanitizer: the threaded runner's tests); tests run, passed, failed (a sanitizer report
+#     fails its test), build and test time (section sanitizers);
+#  I. interruption: `detslam run` on a synthetic static sequence (INT_FRAMES frames, default dnn
+#     segmenter), SIGINT or SIGTERM once 100 frames are done, TRIALS times per mode: exit status,
+#     seconds from the signal to the exit, frames in the outputs, run.json "interrupted"; and a
+#     second SIGINT right after the first (section interruption).
+# Usage: bench/bench_reliability.sh [path/to/detslam]   (env: PARTS="S I", TRIALS=3, INT_FRAMES=400)
+set -euo pipefail
+here="$(cd "$(dirname "$0")" && pwd)"
+root="$(dirname "$here")"
+bin="${1:-$root/build/bin/detslam}"
+parts="${PARTS:-S I}"
+trials="${TRIALS:-3}"
+int_frames="${INT_FRAMES:-400}"
+settings_line="bench/bench_reliability.sh (PARTS=\"$parts\" TRIALS=$trials INT_FRAMES=$int_frames)"
+work="$(mktemp -d)"
+trap 'rm -rf "$work"' EXIT
+bench_name=bench_reliability
+# shellcheck source=bench/bench_lib.sh
+source "$here/bench_lib.sh"
+publish_doc() {  # section file
+  python3 "$here/update_section.py" "$1" "$settings_line" RELIABILITY <"$2"
+  cat "$2"
+}
+
+if want S; then
+  out="$work/sanitizers.md"
+  {
+    echo "Each sanitizer build compiles every library, the \`detslam\` command and the tests with"
+    echo "\`-fsanitize=...\` at -O1 (scripts/sanitize.sh); a report aborts its test, so a clean run is"
+    echo "every selected test passing. Suppressions (scripts/sanitizers/*.supp) name system libraries"
+    echo "only."
+    echo
+    echo "| build | tests selected | passed | failed | build s | tests s |"
+    echo "|---|---|---:|---:|---:|---:|"
+  } >"$out"
+  for kind in address thread; do
+    progress "S: scripts/sanitize.sh $kind"
+    log="$work/sanitize_$kind.log"
+    set +e
+    "$root/scripts/sanitize.sh" "$kind" >"$log" 2>&1
+    set -e
+    python3 - "$log" "$kind" >>"$out" <<'PY'
+import re, sys
+text = open(sys.argv[1]).read()
+kind = sys.argv[2]
+runs = re.findall(r"(\d+)% tests passed, (\d+) tests failed out of (\d+)", text)
+total = sum(int(r[2]) for r in runs)
+failed = sum(int(r[1]) for r in runs)
+build = re.search(r"\[sanitize\] \w+ build: (\d+) s", text)
+tests = re.findall(r"\[sanitize\] \w+ tests?: (\d+) s", text)
+name = {"address": "AddressSanitizer + UndefinedBehaviorSanitizer + LeakSanitizer",
+        "thread": "ThreadSanitizer"}[kind]
+selected = {"address": "all unit tests; integration: runner, interruption, map file, report, "
+                       "vocabulary command, synthetic static run; fr2/desk determinism",
+            "thread": "bounded queue, stage threads; integration: runner, interruption; fr2/desk "
+                      "threaded and mapping-thread runs"}[kind]
+fails = re.findall(r"^\s*\d+ - (\S+) \(", text, re.M)
+print(f"| {name} | {selected} | {total - failed} | {failed}"
+      f"{' (' + ', '.join(fails) + ')' if fails else ''} | {build.group(1) if build else '?'} | "
+      f"{sum(int(t) for t in tests) if tests else '?'} |")
+PY
+  done
+  echo >>"$out"
+  publish_doc sanitizers "$out"
+fi
+
+if want I; then
+  progress "I: interruption ($int_frames-frame static sequence)"
+  "$bin" synth --preset static --seed 1 --frames "$int_frames" --out "$work/seq" >/dev/null 2>&1
+  : >"$work/int.tsv"
+  interrupt_once() {  # mode signal twice trial
+    local mode=$1 sig=$2 twice=$3 o="$work/int_$1_$2_$3_$4"
+    local args=(run --dataset "$work/seq" --out "$o")
+    [ "$mode" = threaded ] && args+=(--threaded)
+    "$bin" "${args[@]}" >"$o.log" 2>&1 &
+    local pid=$!
+    until grep -q "\[run\] 100/" "$o.log" 2>/dev/null; do
+      kill -0 "$pid" 2>/dev/null || { cat "$o.log"; exit 1; }
+      sleep 0.01
+    done
+    local t0 t1 rc
+    t0=$(date +%s.%N)
+    kill "-$sig" "$pid"
+    if [ "$twice" = yes ]; then
+      until grep -q "again to quit at once" "$o.log"; do sleep 0.001; done
+      kill -INT "$pid" 2>/dev/null || true
+    fi
+    set +e
+    wait "$pid"
+    rc=$?
+    set -e
+    t1=$(date +%s.%N)
+    python3 - "$o" "$mode" "$sig" "$twice" "$rc" "$t0" "$t1" >>"$work/int.tsv" <<'PY'
+import json, os, sys
+o, mode, sig, twice, rc, t0, t1 = sys.argv[1:]
+frames, interrupted, lines, tracked = "-", "-", "-", "-"
+if os.path.exists(os.path.join(o, "run.json")):
+    j = json.load(open(os.path.join(o, "run.json")))
+    frames, interrupted = str(j["frames"]), str(j["interrupted"]).lower()
+    tracked = str(j["frames_tracked"])
+t = os.path.join(o, "trajectory.txt")
+if os.path.exists(t):
+    lines = str(sum(1 for l in open(t) if l.strip() and not l.startswith("#")))
+print("\t".join([mode, sig, twice, rc, f"{float(t1) - float(t0):.3f}", frames, interrupted,
+                 f"{lines}/{tracked}"]))
+PY
+  }
+  for mode in sequential threaded; do
+    for sig in INT TERM; do
+      for t in $(seq "$trials"); do interrupt_once "$mode" "$sig" no "$t"; done
+    done
+    for t in $(seq "$trials"); do interrupt_once "$mode" INT yes "$t"; done
+  done
+  out="$work/interruption.md"
+  {
+    echo "\`detslam run\` (default dnn segmenter) on a synthetic \`static\` sequence of $int_frames frames,"
+    echo "signalled once the progress line says 100 frames are done; $trials trials per row. Target:"
+    echo "stops within a second with the outputs of the frames processed so far, marked interrupted;"
+    echo "a second signal quits at once, leaving no truncated file."
+    echo
+    echo "| mode | signal | exit status | seconds from signal to exit: median | max | frames in run.json | run.json interrupted | trajectory.txt lines / tracked frames |"
+    echo "|---|---|---|---:|---:|---|---|---|"
+    python3 - "$work/int.tsv" <<'PY'
+import statistics as st, sys
+rows = [l.rstrip("\n").split("\t") for l in open(sys.argv[1]) if l.strip()]
+for key in dict.fromkeys((r[0], r[1], r[2]) for r in rows):
+    r = [x for x in rows if (x[0], x[1], x[2]) == key]
+    secs = [float(x[4]) for x in r]
+    sig = f"SIG{key[1]}" + (", then SIGINT" if key[2] == "yes" else "")
+    print(f"| {key[0]} | {sig} | {', '.join(sorted(set(x[3] for x in r)))} | {st.median(secs):.2f} | "
+          f"{max(secs):.2f} | {', '.join(x[5] for x in r)} | {', '.join(sorted(set(x[6] for x in r)))} | "
+          f"{', '.join(x[7] for x in r)} |")
+PY
+    echo
+  } >"$out"
+  publish_doc interruption "$out"
+fi
