@@ -27,7 +27,7 @@ function(detslam_module name)
     target_link_libraries(${target} INTERFACE ${ARG_DEPS})
   endif()
   if(DETSLAM_BUILD_TESTS AND test_sources)
-    add_executable(${target}_test ${test_sources})
+    add_executable(${target}_test ${test_sources} ${DETSLAM_TSAN_EXTRA_SOURCE})
     target_link_libraries(${target}_test PRIVATE ${target} ${ARG_TEST_DEPS} detslam_test_support
                           GTest::gmock GTest::gtest_main)
     target_compile_options(${target}_test PRIVATE ${DETSLAM_WARNINGS})

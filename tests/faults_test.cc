@@ -13,6 +13,7 @@
 #include "detslam/io/dataset.h"
 #include "detslam/io/trajectory.h"
 #include "detslam/synth/writer.h"
+#include "integration_util.h"
 #include "support/cli_runner.h"
 
 namespace detslam {
@@ -22,6 +23,7 @@ namespace fs = std::filesystem;
 using ::testing::HasSubstr;
 using testing::ReadFileBytes;
 using testing::RunCli;
+using integration::RunJson;
 using testing::TempDir;
 
 // A static synthetic sequence of `frames` frames in a fresh folder.
@@ -38,10 +40,6 @@ std::string Sequence(const std::string& name, int frames, double cover_start_s =
   }
   WriteSequence(so, dir);
   return dir;
-}
-
-nlohmann::json RunJson(const fs::path& out) {
-  return nlohmann::json::parse(ReadFileBytes(out / "run.json"));
 }
 
 TEST(IntegrationFaults, UnreadableFramesAreSkippedListedAndTheRunGoesOn) {

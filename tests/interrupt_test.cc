@@ -13,7 +13,7 @@
 #include "detslam/io/settings.h"
 #include "detslam/io/trajectory.h"
 #include "detslam/pipeline/runner.h"
-#include "detslam/synth/writer.h"
+#include "integration_util.h"
 #include "support/cli_runner.h"
 
 namespace detslam {
@@ -21,26 +21,14 @@ namespace {
 
 namespace fs = std::filesystem;
 using testing::ReadFileBytes;
+using integration::RunJson;
+using integration::WriteStaticSequence;
 using testing::TempDir;
-
-std::string StaticSequence(const std::string& name, int frames) {
-  const std::string dir = TempDir(name);
-  SynthOptions so;
-  so.preset = "static";
-  so.seed = 1;
-  so.frames = frames;
-  WriteSequence(so, dir);
-  return dir;
-}
 
 // One 300-frame sequence for the command tests (written once per test process).
 const std::string& CommandSequence() {
-  static const std::string dir = StaticSequence("interrupt_cli", 300);
+  static const std::string dir = WriteStaticSequence("interrupt_cli", 1, 300);
   return dir;
-}
-
-nlohmann::json RunJson(const fs::path& out) {
-  return nlohmann::json::parse(ReadFileBytes(out / "run.json"));
 }
 
 // The outputs of an interrupted run agree with each other: run.json says interrupted and how many
@@ -60,7 +48,7 @@ void ExpectInterruptedOutputs(const fs::path& out, size_t min_frames, size_t max
 }
 
 TEST(IntegrationInterrupt, AStopRequestEndsTheRunWithTheOutputsSoFar) {
-  const std::string seq = StaticSequence("interrupt_lib", 120);
+  const std::string seq = WriteStaticSequence("interrupt_lib", 1, 120);
   const RgbdDataset dataset = RgbdDataset::Open(seq, {});
   const Settings settings = PresetForDataset(seq);
   for (const auto& [threaded, mapping_thread] :

@@ -18,6 +18,7 @@
 #include "detslam/place/default_vocabulary.h"
 #include "detslam/segmentation/segmenter_factory.h"
 #include "detslam/synth/writer.h"
+#include "integration_util.h"
 #include "support/cli_runner.h"
 #include "support/shared_data.h"
 
@@ -26,6 +27,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
+using integration::WriteStaticSequence;
 using testing::TempDir;
 
 struct SlamRun {
@@ -127,17 +129,6 @@ TEST(IntegrationSlamDynamic, GroundTruthMasksRemoveThePeople) {
   int frames_with_people = 0;
   for (const FrameReport& r : with_gt.summary.reports) frames_with_people += r.dynamic_instances > 0 ? 1 : 0;
   EXPECT_GT(frames_with_people, 100) << "the filter saw people in too few frames";
-}
-
-// A synthetic `static` preset sequence in a fresh temporary folder; returns the folder.
-std::string WriteStaticSequence(const std::string& name, uint64_t seed, int frames) {
-  const std::string dir = TempDir(name);
-  SynthOptions so;
-  so.preset = "static";
-  so.seed = seed;
-  so.frames = frames;
-  WriteSequence(so, dir);
-  return dir;
 }
 
 // A segmenter that fails on frame `fail_at` (as a model file that cannot be read would).

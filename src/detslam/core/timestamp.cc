@@ -1,6 +1,7 @@
 #include "detslam/core/timestamp.h"
 
 #include <cctype>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 
@@ -22,9 +23,11 @@ bool ParseTimestamp(const std::string& text, Timestamp* out) {
   if (i < text.size() && (text[i] == '-' || text[i] == '+')) negative = text[i++] == '-';
   int64_t whole = 0;
   size_t digits = 0;
+  // At most 9.2e9 s fit in int64 nanoseconds (year 2262): refuse more than 9e9 s.
+  constexpr int64_t kMaxSeconds = 9000000000LL;
   while (i < text.size() && std::isdigit(static_cast<unsigned char>(text[i]))) {
-    if (whole > 9000000000LL) return false;
     whole = whole * 10 + (text[i++] - '0');
+    if (whole > kMaxSeconds) return false;
     ++digits;
   }
   int64_t frac_ns = 0;
@@ -42,7 +45,8 @@ bool ParseTimestamp(const std::string& text, Timestamp* out) {
   if (i < text.size() && (text[i] == 'e' || text[i] == 'E')) {
     char* end = nullptr;
     const double v = std::strtod(text.c_str(), &end);
-    if (end == nullptr || *end != '\0') return false;
+    if (end == nullptr || *end != '\0' || !(std::abs(v) <= static_cast<double>(kMaxSeconds)))
+      return false;
     *out = Timestamp::FromSeconds(v);
     return true;
   }

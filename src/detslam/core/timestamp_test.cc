@@ -20,6 +20,21 @@ TEST(Timestamp, RejectsMalformed) {
   EXPECT_FALSE(ParseTimestamp(".", &t));
 }
 
+// Stamps beyond what int64 nanoseconds hold (found by the trajectory fuzz target: 90000000000
+// overflowed) are refused, in plain and scientific notation.
+TEST(Timestamp, RejectsStampsBeyondNineBillionSeconds) {
+  Timestamp t;
+  EXPECT_TRUE(ParseTimestamp("9000000000.5", &t));
+  EXPECT_EQ(t.ns, 9000000000500000000LL);
+  EXPECT_FALSE(ParseTimestamp("9000000001", &t));
+  EXPECT_FALSE(ParseTimestamp("90000000000", &t));
+  EXPECT_FALSE(ParseTimestamp("-99999999999999999999", &t));
+  EXPECT_FALSE(ParseTimestamp("1e300", &t));
+  EXPECT_FALSE(ParseTimestamp("-1e19", &t));
+  EXPECT_TRUE(ParseTimestamp("1.305e9", &t));
+  EXPECT_EQ(t.ns, 1305000000000000000LL);
+}
+
 TEST(Timestamp, IntegerAndDifference) {
   Timestamp a, b;
   ASSERT_TRUE(ParseTimestamp("10", &a));

@@ -282,7 +282,17 @@ void OrbExtractor::Extract(const cv::Mat& gray, const cv::Mat& ignore_mask,
 
 // On x86-64 GCC/Clang build a POPCNT variant next to the portable one and pick at load time
 // (the default build targets plain x86-64, where __builtin_popcountll is a library call).
-#if defined(__x86_64__) && defined(__GNUC__) && defined(__linux__)
+// The popcnt clone is chosen by an ifunc resolver that runs while the program is being loaded;
+// ThreadSanitizer instruments the resolver before its runtime is up (a crash at start), so its
+// builds keep the default version only.
+#if defined(__SANITIZE_THREAD__)
+#define DETSLAM_TSAN 1
+#elif defined(__has_feature)
+#if __has_feature(thread_sanitizer)
+#define DETSLAM_TSAN 1
+#endif
+#endif
+#if defined(__x86_64__) && defined(__GNUC__) && defined(__linux__) && !defined(DETSLAM_TSAN)
 __attribute__((target_clones("popcnt", "default")))
 #endif
 int DescriptorDistance(const uint8_t* a, const uint8_t* b) {
