@@ -31,8 +31,11 @@ TrackerOptions TrackerFor(const SlamOptions& options) {
 
 bool SlamOptions::Check(std::string* error) const {
   std::string e1, e2, e3, e4, e5;
-  const bool ok = orb.Check(&e1) & tracker.Check(&e2) & mapper.Check(&e3) & dynamic.Check(&e4) &
-                  loop.Check(&e5);
+  // Every check runs (each adds its own message), so the error names all the bad options at once.
+  const bool passed[] = {orb.Check(&e1), tracker.Check(&e2), mapper.Check(&e3), dynamic.Check(&e4),
+                         loop.Check(&e5)};
+  bool ok = true;
+  for (const bool p : passed) ok = ok && p;
   if (error) *error = e1 + e2 + e3 + e4 + e5;
   return ok;
 }
