@@ -52,6 +52,16 @@ inline std::string WithChecksum(std::string body) {
   return body;
 }
 
+// The file for a target of a binary format: the first input byte chooses (bit 0) whether the rest
+// is the file as it is or a body closed by a valid checksum (WithChecksum). False for an empty
+// input.
+inline bool BinaryFile(const uint8_t* data, size_t size, std::string* file) {
+  if (size == 0) return false;
+  *file = Bytes(data + 1, size - 1);
+  if (data[0] & 1) *file = WithChecksum(std::move(*file));
+  return true;
+}
+
 // Splits `text` at every "\n===\n" (one input holding several files).
 inline std::vector<std::string> SplitParts(const std::string& text) {
   std::vector<std::string> parts;

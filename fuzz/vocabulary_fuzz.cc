@@ -8,9 +8,8 @@
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   using namespace detslam;
-  if (size == 0) return 0;
-  std::string bytes = fuzz::Bytes(data + 1, size - 1);
-  if (data[0] & 1) bytes = fuzz::WithChecksum(std::move(bytes));
+  std::string bytes;
+  if (!fuzz::BinaryFile(data, size, &bytes)) return 0;
   const std::string path = fuzz::WriteInput("vocabulary.dslvoc", bytes);
   Vocabulary v;
   if (!fuzz::Accepts([&] { v.Load(path); }) || v.empty()) return 0;
