@@ -314,20 +314,17 @@ class RunRecorder {
     if (progress_) progress_(summary_.frames, total_, r);
   }
 
-  // A frame whose images could not be read: no pose, listed in run.json (skipped_frames).
-  void AddSkipped(int64_t index, Timestamp stamp, const std::string& reason) {
+  // A frame whose images could not be read (r.skipped says why): no pose, listed in run.json
+  // (skipped_frames).
+  void AddSkipped(const FrameReport& r) {
     constexpr size_t kWarnings = 10;
     if (summary_.skipped < kWarnings) {
-      spdlog::warn("frame {} skipped: {}", index, reason);
+      spdlog::warn("frame {} skipped: {}", r.index, r.skipped);
     } else if (summary_.skipped == kWarnings) {
       spdlog::warn("further unreadable frames are skipped without a warning (all in run.json)");
     }
     ++summary_.skipped;
     ++summary_.frames;
-    FrameReport r;
-    r.index = index;
-    r.stamp = stamp;
-    r.skipped = reason;
     summary_.reports.push_back(r);
     if (progress_) progress_(summary_.frames, total_, r);
   }
@@ -426,6 +423,15 @@ LoadedFrame LoadAndSegment(const RgbdDataset& dataset, const Settings& settings,
   return f;
 }
 
+// The report of a frame whose images could not be read (f.unreadable is set).
+FrameReport SkippedReport(const RgbdDataset& dataset, const LoadedFrame& f) {
+  FrameReport r;
+  r.index = f.index;
+  r.stamp = dataset.frame(static_cast<size_t>(f.index)).rgb_stamp;
+  r.skipped = f.unreadable;
+  return r;
+}
+
 Frame Extract(const SlamSystem& slam, const RgbdDataset& dataset, const LoadedFrame& f,
               FrameReport* report) {
   report->segmentation_ms = f.segmentation_ms;
@@ -449,7 +455,7 @@ RunSummary RunSequential(const RgbdDataset& dataset, const Settings& settings,
   for (size_t i = 0; i < n && !StopRequested(options); ++i) {
     const LoadedFrame loaded = LoadAndSegment(dataset, settings, i, &slam);
     if (!loaded.unreadable.empty()) {
-      recorder.AddSkipped(loaded.index, dataset.frame(i).rgb_stamp, loaded.unreadable);
+      recorder.AddSkipped(SkippedReport(dataset, loaded));
       continue;
     }
     FrameReport report;
@@ -502,8 +508,7 @@ RunSummary RunThreaded(const RgbdDataset& dataset, const Settings& settings,
           if (StopRequested(options)) break;
           Extracted e;
           if (!f->unreadable.empty()) {
-            e.report.index = f->index;
-            e.report.skipped = f->unreadable;
+            e.report = SkippedReport(dataset, *f);
           } else {
             e.frame = Extract(slam, dataset, *f, &e.report);
           }
@@ -526,9 +531,7 @@ RunSummary RunThreaded(const RgbdDataset& dataset, const Settings& settings,
         while (std::optional<Extracted> e = extracted.Pop()) {
           if (StopRequested(options)) break;
           if (!e->report.skipped.empty()) {
-            recorder.AddSkipped(e->report.index,
-                                dataset.frame(static_cast<size_t>(e->report.index)).rgb_stamp,
-                                e->report.skipped);
+            recorder.AddSkipped(e->report);
             continue;
           }
           const KeyFrameId kf = slam.TrackFrame(std::move(e->frame), &e->report);
