@@ -42,6 +42,7 @@ export TSAN_OPTIONS="halt_on_error=1:second_deadlock_stack=1:suppressions=$supp/
 # OpenMP inside SuiteSparse (Ceres) in one thread under ThreadSanitizer, as OpenCV's loops are
 # (tests/support/opencv_single_thread.cc): their pools are invisible to it.
 if [ "$kind" = thread ]; then export OMP_NUM_THREADS=1; fi
+start=$(date +%s)  # the tests' time, unit and integration together
 if [ $# -eq 0 ]; then
   if [ "$kind" = address ]; then
     # Unit tests, and the integration tests that reach every module without the long accuracy
@@ -55,6 +56,5 @@ if [ $# -eq 0 ]; then
       -E "ASecondSignal"
   fi
 fi
-start=$(date +%s)
 ctest --test-dir "$BUILD_DIR" --output-on-failure -j "$JOBS" --timeout 1800 "$@"
 echo "[sanitize] $kind tests: $(( $(date +%s) - start )) s"

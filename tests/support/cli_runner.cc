@@ -67,15 +67,18 @@ void ChildProcess::Signal(int sig) const {
   if (pid_ > 0 && status_ < 0) ::kill(pid_, sig);
 }
 
+bool ChildProcess::Exited() {
+  int status = 0;
+  if (status_ < 0 && ::waitpid(pid_, &status, WNOHANG) == pid_)
+    status_ = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+  return status_ >= 0;
+}
+
 bool ChildProcess::WaitForLog(const std::string& text, std::chrono::milliseconds timeout) {
   const auto end = std::chrono::steady_clock::now() + timeout;
   while (std::chrono::steady_clock::now() < end) {
     if (ReadFileBytes(log_).find(text) != std::string::npos) return true;
-    int status = 0;
-    if (::waitpid(pid_, &status, WNOHANG) == pid_) {
-      status_ = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-      return ReadFileBytes(log_).find(text) != std::string::npos;
-    }
+    if (Exited()) return ReadFileBytes(log_).find(text) != std::string::npos;
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
   }
   return false;
@@ -83,12 +86,7 @@ bool ChildProcess::WaitForLog(const std::string& text, std::chrono::milliseconds
 
 int ChildProcess::Wait(std::chrono::milliseconds timeout) {
   const auto end = std::chrono::steady_clock::now() + timeout;
-  while (status_ < 0) {
-    int status = 0;
-    if (::waitpid(pid_, &status, WNOHANG) == pid_) {
-      status_ = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-      break;
-    }
+  while (!Exited()) {
     if (std::chrono::steady_clock::now() >= end) return -1;
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
   }

@@ -39,6 +39,7 @@ class ChildProcess {
   int Wait(std::chrono::milliseconds timeout);
 
  private:
+  bool Exited();  // reaps the process if it has exited (never blocks); true once it has
   pid_t pid_ = -1;
   int status_ = -1;  // once exited
   std::filesystem::path log_;
