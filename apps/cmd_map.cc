@@ -12,7 +12,7 @@
 namespace detslam::app {
 namespace {
 
-void Info(const std::string& path) {
+void PrintMapInfo(const std::string& path) {
   const MapFileInfo info = ReadMapFileInfo(path);
   const PinholeCamera& c = info.camera;
   std::printf("%s: detslam map file, format version %u, %" PRIu64 " bytes\n", path.c_str(),
@@ -36,7 +36,7 @@ void AddMapCommand(CLI::App& app) {
   auto* info = cmd->add_subcommand("info", "Check a map file and print what it holds");
   auto file = std::make_shared<std::string>();
   info->add_option("file", *file, "Map file")->required();
-  info->callback([file] { Info(*file); });
+  info->callback([file] { PrintMapInfo(*file); });
 }
 
 }  // namespace detslam::app

@@ -52,7 +52,9 @@ class ProgressBar {
   explicit ProgressBar(bool enabled) : tty_(enabled && isatty(fileno(stderr))) {}
   void Update(size_t done, size_t total, const FrameReport& r) {
     if (!tty_) {
-      if (done % 100 == 0 || done == total) std::fprintf(stderr, "[run] %zu/%zu frames\n", done, total);
+      if (done % 100 == 0 || done == total)
+        std::fprintf(stderr, "[run] %zu/%zu frames, %d keyframes, %d map points\n", done, total,
+                     r.map_keyframes, r.map_points);
       return;
     }
     const int width = 30;

@@ -117,7 +117,7 @@ void Train(const std::vector<std::string>& sources, const std::string& out,
             << vocabulary.num_nodes() << " nodes, " << images.size() << " images)\n";
 }
 
-void Info(const std::string& path) {
+void PrintVocabularyInfo(const std::string& path) {
   Vocabulary vocabulary;
   vocabulary.Load(path);
   std::cout << "file: " << path << "\n"
@@ -178,7 +178,7 @@ void AddVocabCommand(CLI::App& app) {
   auto* info = cmd->add_subcommand("info", "Print a vocabulary file's parameters");
   auto file = std::make_shared<std::string>();
   info->add_option("file", *file, "Vocabulary file")->required();
-  info->callback([file] { Info(*file); });
+  info->callback([file] { PrintVocabularyInfo(*file); });
 
   auto* score = cmd->add_subcommand("score", "Print the pairwise bag-of-words scores of images");
   auto score_vocabulary = std::make_shared<std::string>();

@@ -10,18 +10,28 @@
 #  I. interruption: `detslam run` on a synthetic static sequence (INT_FRAMES frames, default dnn
 #     segmenter), SIGINT or SIGTERM once 100 frames are done, TRIALS times per mode: exit status,
 #     seconds from the signal to the exit, frames in the outputs, run.json "interrupted"; and a
-#     second SIGINT right after the first (section interruption).
+#     second SIGINT right after the first (section interruption);
+#  X. faults: bench/fault_cases.py damages a synthetic sequence (or the command line, or the disk)
+#     one way per case and checks the behaviour decided for it (section faults);
+#  K. soak: `detslam run --threaded` (default dnn segmenter) on a synthetic `loop` sequence of
+#     SOAK_FRAMES frames with a person, under a watchdog (bench/soak_monitor.py: no frame finished
+#     for 120 s = hung, stacks dumped) sampling resident memory and the atlas size
+#     (docs/reliability_soak.svg); then two sequential runs of its first SOAK_SEQ_FRAMES frames
+#     whose outputs must be byte-identical (section soak).
 # Usage: bench/bench_reliability.sh [path/to/detslam]
-#   (env: PARTS="S F I", TRIALS=3, INT_FRAMES=400, FUZZ_RUNS=100000)
+#   (env: PARTS="S F I X K", TRIALS=3, INT_FRAMES=400, FUZZ_RUNS=100000, SOAK_FRAMES=20000,
+#    SOAK_SEQ_FRAMES=1000)
 set -euo pipefail
 here="$(cd "$(dirname "$0")" && pwd)"
 root="$(dirname "$here")"
 bin="${1:-$root/build/bin/detslam}"
-parts="${PARTS:-S F I}"
+parts="${PARTS:-S F I X K}"
 fuzz_runs="${FUZZ_RUNS:-100000}"
 trials="${TRIALS:-3}"
 int_frames="${INT_FRAMES:-400}"
-settings_line="bench/bench_reliability.sh (PARTS=\"$parts\" TRIALS=$trials INT_FRAMES=$int_frames FUZZ_RUNS=$fuzz_runs)"
+soak_frames="${SOAK_FRAMES:-20000}"
+soak_seq_frames="${SOAK_SEQ_FRAMES:-1000}"
+settings_line="bench/bench_reliability.sh (PARTS=\"$parts\" TRIALS=$trials INT_FRAMES=$int_frames FUZZ_RUNS=$fuzz_runs SOAK_FRAMES=$soak_frames SOAK_SEQ_FRAMES=$soak_seq_frames)"
 work="$(mktemp -d)"
 trap 'rm -rf "$work"' EXIT
 bench_name=bench_reliability
@@ -184,4 +194,65 @@ PY
     echo
   } >"$out"
   publish_doc interruption "$out"
+fi
+
+if want X; then
+  progress "X: fault cases (bench/fault_cases.py)"
+  out="$work/faults.md"
+  set +e
+  python3 "$here/fault_cases.py" "$bin" "$work/faults" >"$out"
+  rc=$?
+  set -e
+  publish_doc faults "$out"
+  [ "$rc" -eq 0 ] || { echo "bench_reliability: a fault case did not behave as decided" >&2; exit 1; }
+fi
+
+if want K; then
+  progress "K: soak, $soak_frames frames (one synthetic lap of 960 frames, listed again and again)"
+  seq="$work/soak_seq"
+  "$bin" synth --preset loop --seed 1 --frames 960 --out "$seq" >/dev/null
+  python3 "$here/repeat_sequence.py" "$seq" 32.0 "$soak_frames"
+  progress "K: soak run (threaded, watchdog 120 s)"
+  set +e
+  python3 "$here/soak_monitor.py" "$work/soak" 120 -- "$bin" run --dataset "$seq" \
+    --out "$work/soak_run" --threaded
+  soak_rc=$?
+  set -e
+  ate="-"
+  if [ -f "$work/soak_run/trajectory.txt" ]; then
+    ate=$("$bin" eval --gt "$seq/groundtruth.txt" --est "$work/soak_run/trajectory.txt" \
+      --json "$work/soak_eval.json" >/dev/null 2>&1 &&
+      python3 -c "import json,sys; print(f\"{json.load(open(sys.argv[1]))['ate']['rmse']:.4f}\")" \
+        "$work/soak_eval.json" || echo "-")
+  fi
+  progress "K: two sequential runs of the first $soak_seq_frames frames"
+  for k in 1 2; do
+    "$bin" run --dataset "$seq" --out "$work/seq_run$k" --max-frames "$soak_seq_frames" \
+      --no-progress >"$work/seq_run$k.log" 2>&1
+  done
+  identical=yes
+  differing=""
+  for f in $(cd "$work/seq_run1" && ls); do
+    [ "$f" = run.json ] || [ "$f" = report.html ] && continue  # they hold timings
+    cmp -s "$work/seq_run1/$f" "$work/seq_run2/$f" || { identical=NO; differing+=" $f"; }
+  done
+  files=$(cd "$work/seq_run1" && ls | grep -v -e '^run.json$' -e '^report.html$' | tr '\n' ' ')
+  out="$work/soak.md"
+  {
+    echo "\`detslam run --threaded\` (default dnn segmenter) on $soak_frames frames at 30 Hz"
+    echo "($((soak_frames / 1800)) min $(((soak_frames % 1800) / 30)) s): one lap of the synthetic \`loop\` preset (seed 1, 960"
+    echo "frames = 32 s, the camera's circuit closes exactly; a person walks behind the desk) listed"
+    echo "again and again with later timestamps (bench/repeat_sequence.py), so the camera goes round"
+    echo "the same room $(( (soak_frames + 959) / 960 )) times; the images of each lap are the same files (the person"
+    echo "jumps where a lap starts again). A run counts as hung when no frame finishes for 120 s"
+    echo "(watchdog); memory is sampled twice a second."
+    echo
+    python3 "$here/soak_report.py" "$work/soak" "$work/soak_run" "$ate" "$soak_rc" "$soak_frames"
+    echo "Repeated sequential runs (first $soak_seq_frames frames, same seed): outputs ${files}"
+    echo "byte-identical: **$identical**${differing:+ (differ:$differing)}."
+    echo
+  } >"$out"
+  publish_doc soak "$out"
+  [ "$soak_rc" -eq 0 ] && [ "$identical" = yes ] ||
+    { echo "bench_reliability: the soak run failed" >&2; exit 1; }
 fi

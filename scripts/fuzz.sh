@@ -3,7 +3,9 @@
 # and runs each on a copy of its seed corpus (fuzz/corpus/<target>).
 #   scripts/fuzz.sh [SECONDS]   each target for SECONDS (default 10)
 #   RUNS=N scripts/fuzz.sh      each target for N inputs instead
-# env: FUZZ_TARGETS="trajectory dataset ..." (default all), BUILD_DIR (default build-fuzz).
+# env: FUZZ_TARGETS="trajectory dataset ..." (default all), BUILD_DIR (default build-fuzz),
+# REUSE_BUILD=1: BUILD_DIR is already configured for fuzzing (e.g. by
+# `FUZZ=1 scripts/sanitize.sh address`, whose tests then share the build), only build the targets.
 # Prints one line per target: inputs tried, seconds, result; a crash, sanitizer report, leak,
 # timeout (an input taking over 10 s) or uncaught exception other than InputError fails the
 # script, with the input saved under BUILD_DIR/crashes/.
@@ -17,10 +19,15 @@ JOBS=${JOBS:-$(nproc)}
 command -v clang++ >/dev/null || { echo "scripts/fuzz.sh needs clang++ (apt-get install clang)" >&2; exit 2; }
 GEN=()
 if command -v ninja >/dev/null 2>&1; then GEN=(-G Ninja); fi
-cmake -S "$ROOT" -B "$BUILD_DIR" "${GEN[@]}" -DCMAKE_CXX_COMPILER=clang++ \
-  -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1" \
-  -DDETSLAM_SANITIZE="address,undefined,fuzzer-no-link" -DDETSLAM_FUZZ=ON \
-  -DDETSLAM_BUILD_TESTS=OFF -DDETSLAM_BUILD_BENCH=OFF >/dev/null
+if [ -z "${REUSE_BUILD:-}" ]; then
+  cmake -S "$ROOT" -B "$BUILD_DIR" "${GEN[@]}" -DCMAKE_CXX_COMPILER=clang++ \
+    -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1" \
+    -DDETSLAM_SANITIZE="address,undefined,fuzzer-no-link" -DDETSLAM_FUZZ=ON \
+    -DDETSLAM_BUILD_TESTS=OFF -DDETSLAM_BUILD_BENCH=OFF >/dev/null
+elif ! grep -q "^DETSLAM_FUZZ:BOOL=ON" "$BUILD_DIR/CMakeCache.txt" 2>/dev/null; then
+  echo "REUSE_BUILD: $BUILD_DIR is not configured with DETSLAM_FUZZ=ON" >&2
+  exit 2
+fi
 start=$(date +%s)
 # shellcheck disable=SC2086
 cmake --build "$BUILD_DIR" -j "$JOBS" --target $(printf 'fuzz_%s ' $targets)

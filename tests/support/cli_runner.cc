@@ -37,6 +37,12 @@ std::string TempDir(const std::string& name) {
   return p.string();
 }
 
+std::string TempPath(const std::string& name) {
+  return (std::filesystem::temp_directory_path() /
+          ("detslam_" + std::to_string(::getpid()) + "_" + name))
+      .string();
+}
+
 ChildProcess::ChildProcess(const std::string& binary, const std::vector<std::string>& args,
                            const std::filesystem::path& log)
     : log_(log) {

@@ -21,6 +21,9 @@ std::string ReadFileBytes(const std::filesystem::path& path);
 // A fresh, empty folder for one test, per process (two test runs on one machine never share it).
 std::string TempDir(const std::string& name);
 
+// A path for one file of a test in the temporary folder, per process (nothing is created).
+std::string TempPath(const std::string& name);
+
 // A command started in the background (no shell), stdout and stderr into a log file, for tests
 // that signal it while it runs. The destructor kills it if it still runs.
 class ChildProcess {

@@ -10,7 +10,7 @@ namespace detslam {
 namespace {
 
 // A textured square (the "person") at `corner` over a differently textured background.
-cv::Mat Scene(cv::Point corner) {
+cv::Mat SquareImage(cv::Point corner) {
   cv::Mat img(240, 320, CV_8UC1);
   cv::RNG bg(1), fg(2);
   bg.fill(img, cv::RNG::UNIFORM, 0, 100);
@@ -38,15 +38,15 @@ cv::Point2d Centroid(const cv::Mat& mask) {
 
 TEST(MaskPropagation, EmptyBeforeTheFirstSegmentedFrame) {
   MaskPropagator p;
-  EXPECT_TRUE(p.Propagate(Scene({50, 50})).empty());
+  EXPECT_TRUE(p.Propagate(SquareImage({50, 50})).empty());
 }
 
 TEST(MaskPropagation, MasksFollowTheMovingObjectAndGrowWithAge) {
   MaskPropagationOptions o;
   o.grow_px_per_frame = 2;
   MaskPropagator p(o);
-  p.Reset(Scene({100, 80}), {Square({100, 80})});
-  std::vector<Instance> out = p.Propagate(Scene({106, 83}));
+  p.Reset(SquareImage({100, 80}), {Square({100, 80})});
+  std::vector<Instance> out = p.Propagate(SquareImage({106, 83}));
   ASSERT_EQ(out.size(), 1u);
   EXPECT_EQ(p.age(), 1);
   cv::Point2d c = Centroid(out[0].mask);
@@ -56,14 +56,14 @@ TEST(MaskPropagation, MasksFollowTheMovingObjectAndGrowWithAge) {
   EXPECT_NEAR(cv::countNonZero(out[0].mask), 64 * 64, 40);
   EXPECT_EQ(out[0].box, cv::Rect(104, 81, 64, 64));
   // Second frame: follows again, from the previous (propagated) frame, grown by 4 px.
-  out = p.Propagate(Scene({112, 86}));
+  out = p.Propagate(SquareImage({112, 86}));
   ASSERT_EQ(out.size(), 1u);
   c = Centroid(out[0].mask);
   EXPECT_NEAR(c.x, 142, 1.0);
   EXPECT_NEAR(c.y, 116, 1.0);
   EXPECT_EQ(out[0].box, cv::Rect(108, 82, 68, 68));
   // A new segmentation resets the age.
-  p.Reset(Scene({112, 86}), {Square({112, 86})});
+  p.Reset(SquareImage({112, 86}), {Square({112, 86})});
   EXPECT_EQ(p.age(), 0);
 }
 

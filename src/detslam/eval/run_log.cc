@@ -90,6 +90,8 @@ RunLog ReadRunLog(const std::string& path) {
     l.mapping_ms = Get<double>(f, "mapping_ms", path, where);
     if (f.contains("map")) l.map = Get<int>(f, "map", path, where);
     if (f.contains("final_map")) l.final_map = Get<int>(f, "final_map", path, where);
+    if (f.contains("map_keyframes")) l.map_keyframes = Get<int>(f, "map_keyframes", path, where);
+    if (f.contains("map_points")) l.map_points = Get<int>(f, "map_points", path, where);
     r.per_frame.push_back(std::move(l));
   }
   return r;

@@ -26,6 +26,7 @@ struct RunFrameLog {
   double segmentation_ms = 0, extraction_ms = 0, tracking_ms = 0, mapping_ms = 0;
   int map = -1;        // map of the atlas it was tracked in (-1: no pose, or an older run log)
   int final_map = -1;  // map that holds it at the end (maps merged count as the one they joined)
+  int map_keyframes = -1, map_points = -1;  // atlas size after the frame (-1: an older run log)
 };
 
 // Several maps (run.json "maps"; absent in older run logs: main -1).

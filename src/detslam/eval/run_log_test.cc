@@ -85,6 +85,18 @@ TEST_F(RunLogTest, ReadsCountsAndFrames) {
   EXPECT_DOUBLE_EQ(f.segmentation_ms, 41.5);
   EXPECT_DOUBLE_EQ(f.extraction_ms, 8.25);
   EXPECT_DOUBLE_EQ(f.tracking_ms, 3.5);
+  EXPECT_EQ(f.map_keyframes, -1);  // not in this (older) run log
+}
+
+TEST_F(RunLogTest, ReadsTheAtlasSizeAfterEachFrame) {
+  std::string frame = kFrame;
+  frame.replace(frame.find("\"index\": 1,"), 11,
+                "\"index\": 1, \"map_keyframes\": 17, \"map_points\": 4321,");
+  const RunLog r = ReadRunLog(Write(RunJson(frame)));
+  EXPECT_EQ(r.per_frame[0].map_keyframes, 17);
+  EXPECT_EQ(r.per_frame[0].map_points, 4321);
+  frame.replace(frame.find("4321"), 4, "\"many\"");
+  EXPECT_THAT(Error(Write(RunJson(frame))), HasSubstr("map_points"));
 }
 
 TEST_F(RunLogTest, ReadsTheMapsOfTheAtlasWhereTheRunWroteThem) {

@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "detslam/core/check.h"
+#include "detslam/core/math.h"
 #include "detslam/features/keypoint_distribution.h"
 #include "detslam/features/orb_pattern.h"
 
@@ -21,7 +22,6 @@ constexpr int kEdgeThreshold = 19;                 // border added around each l
 constexpr int kDetectBorder = kEdgeThreshold - 3;  // keypoints lie at least this far inside
 constexpr int kCellSize = 35;                      // FAST threshold cells (ORB-SLAM's W)
 constexpr int kFastRadius = 3;                     // FAST needs this many pixels around a candidate
-constexpr double kPi = 3.14159265358979323846;
 
 // Half-widths of the radius-15 circular patch, per row offset 0..15: u^2 + v^2 <= 15^2.
 std::array<int, kHalfPatch + 1> CircleHalfWidths() {

@@ -15,15 +15,19 @@ inline cv::Mat MakeTexture(int width, int height, uint64_t seed, int num_shapes 
   cv::Mat image(height, width, CV_8UC1, cv::Scalar(128));
   for (int i = 0; i < num_shapes; ++i) {
     const int size = rng.UniformInt(4, 40);
-    const cv::Point center(rng.UniformInt(-10, width + 10), rng.UniformInt(-10, height + 10));
+    // One draw per declarator (argument order is unspecified: gcc and clang differ), in the
+    // order gcc drew them when they were arguments, so the images stay as they were.
+    const int cy = rng.UniformInt(-10, height + 10), cx = rng.UniformInt(-10, width + 10);
+    const cv::Point center(cx, cy);
     const cv::Scalar color(rng.UniformInt(0, 255));
     if (rng.UniformInt(0, 1) == 0) {
-      const cv::Point corner(center.x + rng.UniformInt(-size, size),
-                             center.y + rng.UniformInt(-size, size));
-      cv::rectangle(image, center, corner, color, cv::FILLED);
+      const int dy = rng.UniformInt(-size, size), dx = rng.UniformInt(-size, size);
+      cv::rectangle(image, center, cv::Point(center.x + dx, center.y + dy), color, cv::FILLED);
     } else {
-      cv::ellipse(image, center, cv::Size(size, rng.UniformInt(2, size)), rng.Uniform(0, 180), 0,
-                  360, color, cv::FILLED, cv::LINE_AA);
+      const double angle = rng.Uniform(0, 180);
+      const int minor = rng.UniformInt(2, size);
+      cv::ellipse(image, center, cv::Size(size, minor), angle, 0, 360, color, cv::FILLED,
+                  cv::LINE_AA);
     }
   }
   cv::GaussianBlur(image, image, cv::Size(3, 3), 0.8);

@@ -11,7 +11,7 @@
 namespace detslam {
 namespace {
 
-constexpr int kSampleSize = 4;  // AP3P: three points for the solutions, a fourth to pick one
+constexpr int kPnpSampleSize = 4;  // AP3P: three points for the solutions, a fourth to pick one
 
 Rigid3d FromRvecTvec(const cv::Mat& rvec, const cv::Mat& tvec) {
   const Eigen::Vector3d r(rvec.at<double>(0), rvec.at<double>(1), rvec.at<double>(2));
@@ -110,8 +110,8 @@ PnpResult SolvePnpRansac(const PinholeCamera& camera,
   }
   const PnpProblem problem(camera, points_world, pixels, sigma2, options.chi2_threshold);
   RansacOutcome<Rigid3d> outcome = RunRansac<Rigid3d>(
-      static_cast<int>(points_world.size()), kSampleSize,
-      std::max(kSampleSize, options.min_inliers), options, rng,
+      static_cast<int>(points_world.size()), kPnpSampleSize,
+      std::max(kPnpSampleSize, options.min_inliers), options, rng,
       [&](const std::vector<int>& sample, Rigid3d* pose) {
         return problem.Solve(sample, cv::SOLVEPNP_AP3P, nullptr, pose);
       },

@@ -15,7 +15,7 @@ struct PnpScene {
 };
 
 // n correspondences; a fraction outlier_ratio gets a random pixel at least 20 px from the truth.
-PnpScene MakeScene(const PinholeCamera& camera, int n, double outlier_ratio, Rng& rng) {
+PnpScene MakePnpScene(const PinholeCamera& camera, int n, double outlier_ratio, Rng& rng) {
   PnpScene s;
   Eigen::Matrix<double, 6, 1> twist;
   twist << 0.3, -0.2, 0.5, 0.1, -0.25, 0.05;
@@ -43,7 +43,7 @@ PnpScene MakeScene(const PinholeCamera& camera, int n, double outlier_ratio, Rng
 TEST(PnpRansacTest, RecoversExactPoseWithFortyPercentOutliers) {
   const PinholeCamera camera;
   Rng scene_rng(1);
-  const PnpScene s = MakeScene(camera, 200, 0.4, scene_rng);
+  const PnpScene s = MakePnpScene(camera, 200, 0.4, scene_rng);
   Rng rng(42);
   const PnpResult r = SolvePnpRansac(camera, s.points, s.pixels, {}, RansacOptions(), rng);
   ASSERT_TRUE(r.success);
@@ -59,7 +59,7 @@ TEST(PnpRansacTest, RecoversExactPoseWithFortyPercentOutliers) {
 TEST(PnpRansacTest, SameSeedGivesIdenticalResult) {
   const PinholeCamera camera;
   Rng scene_rng(2);
-  const PnpScene s = MakeScene(camera, 150, 0.4, scene_rng);
+  const PnpScene s = MakePnpScene(camera, 150, 0.4, scene_rng);
   Rng rng1(7), rng2(7);
   const PnpResult a = SolvePnpRansac(camera, s.points, s.pixels, {}, RansacOptions(), rng1);
   const PnpResult b = SolvePnpRansac(camera, s.points, s.pixels, {}, RansacOptions(), rng2);
@@ -88,7 +88,7 @@ TEST(PnpRansacTest, FailsOnPureNoise) {
 TEST(PnpRansacTest, Sigma2ScalesTheInlierTest) {
   const PinholeCamera camera;
   Rng scene_rng(4);
-  PnpScene s = MakeScene(camera, 60, 0.0, scene_rng);
+  PnpScene s = MakePnpScene(camera, 60, 0.0, scene_rng);
   // Move the last 10 observations by 5 px: chi2 = 25 / sigma2.
   for (int i = 50; i < 60; ++i) s.pixels[i].x() += 5.0;
   std::vector<double> sigma2(60, 1.0);
@@ -106,7 +106,7 @@ TEST(PnpRansacTest, Sigma2ScalesTheInlierTest) {
 TEST(PnpRansacTest, TooFewPointsAndBadInput) {
   const PinholeCamera camera;
   Rng rng(6);
-  const PnpScene s = MakeScene(camera, 8, 0.0, rng);
+  const PnpScene s = MakePnpScene(camera, 8, 0.0, rng);
   EXPECT_FALSE(SolvePnpRansac(camera, s.points, s.pixels, {}, RansacOptions(), rng).success);
   std::vector<Eigen::Vector2d> short_pixels(s.pixels.begin(), s.pixels.end() - 1);
   EXPECT_THROW(SolvePnpRansac(camera, s.points, short_pixels, {}, RansacOptions(), rng),

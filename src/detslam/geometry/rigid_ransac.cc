@@ -10,7 +10,7 @@
 namespace detslam {
 namespace {
 
-constexpr int kSampleSize = 3;
+constexpr int kRigidSampleSize = 3;
 
 int Classify(const std::vector<Eigen::Vector3d>& a, const std::vector<Eigen::Vector3d>& b,
              const Rigid3d& b_from_a, double threshold, std::vector<bool>* inliers) {
@@ -66,7 +66,7 @@ RigidRansacResult EstimateRigidRansac(const std::vector<Eigen::Vector3d>& a,
     throw InputError("EstimateRigidRansac: inlier threshold must be positive");
   }
   RansacOutcome<Rigid3d> outcome = RunRansac<Rigid3d>(
-      static_cast<int>(a.size()), kSampleSize, kSampleSize, options, rng,
+      static_cast<int>(a.size()), kRigidSampleSize, kRigidSampleSize, options, rng,
       [&](const std::vector<int>& sample, Rigid3d* b_from_a) {
         return FitRigidKabsch(a, b, sample, b_from_a);
       },

@@ -13,7 +13,7 @@ struct RigidScene {
   std::vector<bool> is_inlier;
 };
 
-RigidScene MakeScene(int n, double outlier_ratio, Rng& rng) {
+RigidScene MakeRigidScene(int n, double outlier_ratio, Rng& rng) {
   RigidScene s;
   Eigen::Matrix<double, 6, 1> twist;
   twist << 1.0, -0.5, 0.2, 0.4, 0.3, -0.6;
@@ -47,7 +47,7 @@ TEST(RigidRansacTest, KabschHandMade) {
 
 TEST(RigidRansacTest, RecoversExactTransformWithFortyPercentOutliers) {
   Rng scene_rng(11);
-  const RigidScene s = MakeScene(100, 0.4, scene_rng);
+  const RigidScene s = MakeRigidScene(100, 0.4, scene_rng);
   Rng rng(12);
   const RigidRansacResult r = EstimateRigidRansac(s.a, s.b, 0.05, RansacOptions(), rng);
   ASSERT_TRUE(r.success);
@@ -60,7 +60,7 @@ TEST(RigidRansacTest, RecoversExactTransformWithFortyPercentOutliers) {
 
 TEST(RigidRansacTest, SameSeedGivesIdenticalResult) {
   Rng scene_rng(13);
-  const RigidScene s = MakeScene(80, 0.4, scene_rng);
+  const RigidScene s = MakeRigidScene(80, 0.4, scene_rng);
   Rng rng1(99), rng2(99);
   const RigidRansacResult a = EstimateRigidRansac(s.a, s.b, 0.05, RansacOptions(), rng1);
   const RigidRansacResult b = EstimateRigidRansac(s.a, s.b, 0.05, RansacOptions(), rng2);

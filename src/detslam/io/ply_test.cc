@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "detslam/core/check.h"
+#include "support/cli_runner.h"
 
 namespace detslam {
 namespace {
@@ -45,10 +46,7 @@ float FloatLe(const std::string& bytes, size_t offset) {
   return f;
 }
 
-std::string TempPath(const std::string& name) {
-  return (fs::temp_directory_path() / ("detslam_io_ply_" + std::to_string(::getpid()) + "_" + name))
-      .string();
-}
+using testing::TempPath;
 
 TEST(Ply, ColouredCloudHeaderAndFirstVertex) {
   const std::string path = TempPath("colour.ply");

@@ -6,13 +6,12 @@
 #include <fstream>
 
 #include "detslam/core/check.h"
+#include "support/cli_runner.h"
 
 namespace detslam {
 namespace {
 
-std::string TempPath(const std::string& name) {
-  return (std::filesystem::temp_directory_path() / ("detslam_traj_" + name)).string();
-}
+using testing::TempPath;
 
 void WriteText(const std::string& path, const std::string& text) { std::ofstream(path) << text; }
 

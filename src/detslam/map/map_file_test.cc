@@ -10,6 +10,7 @@
 #include "detslam/core/binary_io.h"
 #include "detslam/core/check.h"
 #include "detslam/map/map_test_util.h"
+#include "support/cli_runner.h"
 
 namespace detslam {
 namespace {
@@ -17,9 +18,7 @@ namespace {
 using map_test::PartsOf;
 using map_test::RestoreLike;
 
-std::string TempPath(const std::string& name) {
-  return ::testing::TempDir() + "/detslam_map_file_" + name;
-}
+using testing::TempPath;
 
 std::string ReadAll(const std::string& path) { return ReadFileBytes(path, 1u << 30, "test"); }
 

@@ -34,7 +34,10 @@ Scene MakeScene(Rng& rng, const PinholeCamera& camera = URightCamera()) {
     s.truth.poses.push_back({i, Rigid3d::Exp(world_from_cam).Inverse(), i == 0});
   }
   for (int j = 0; j < 200; ++j) {
-    const Eigen::Vector3d p(rng.Uniform(-0.5, 2.3), rng.Uniform(-0.8, 0.8), rng.Uniform(2, 4));
+    // One draw per declarator (argument order is unspecified: gcc and clang differ), in the
+    // order gcc drew them as arguments (last first), so the scene stays as it was measured.
+    const double z = rng.Uniform(2, 4), y = rng.Uniform(-0.8, 0.8), x = rng.Uniform(-0.5, 2.3);
+    const Eigen::Vector3d p(x, y, z);
     s.truth.points.push_back({1000 + j, p, false});
   }
   for (size_t i = 0; i < s.truth.poses.size(); ++i) {
@@ -45,7 +48,8 @@ Scene MakeScene(Rng& rng, const PinholeCamera& camera = URightCamera()) {
       BundleProblem::Observation o;
       o.pose_index = i;
       o.point_index = j;
-      o.uv = uvr.head<2>() + Eigen::Vector2d(rng.Normal(), rng.Normal());
+      const double nv = rng.Normal(), nu = rng.Normal();
+      o.uv = uvr.head<2>() + Eigen::Vector2d(nu, nv);
       if ((i + j) % 2 == 0) {
         o.u_right = camera.disparity_sigma > 0
                         ? o.uv.x() - (camera.bf / p_cam.z() + rng.Normal(0, camera.disparity_sigma))
@@ -62,7 +66,8 @@ Scene MakeScene(Rng& rng, const PinholeCamera& camera = URightCamera()) {
     s.problem.poses[i].cam_from_world = Rigid3d::Exp(d) * s.problem.poses[i].cam_from_world;
   }
   for (BundleProblem::Point& p : s.problem.points) {
-    p.p_world += Eigen::Vector3d(rng.Normal(0, 0.05), rng.Normal(0, 0.05), rng.Normal(0, 0.05));
+    const double dz = rng.Normal(0, 0.05), dy = rng.Normal(0, 0.05), dx = rng.Normal(0, 0.05);
+    p.p_world += Eigen::Vector3d(dx, dy, dz);
   }
   return s;
 }

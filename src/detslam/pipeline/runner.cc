@@ -196,6 +196,8 @@ void WriteOutputs(const RgbdDataset& dataset, const Settings& settings, const Ru
                          {"keyframe", r.keyframe},
                          {"loop_closed", r.loop_closed},
                          {"keypoints", r.num_keypoints},
+                         {"map_keyframes", r.map_keyframes},
+                         {"map_points", r.map_points},
                          {"dynamic_instances", r.dynamic_instances},
                          {"rejected_keypoints", r.rejected_keypoints},
                          {"geometric_rejected", r.tracking.geometric_rejected},

@@ -279,6 +279,8 @@ KeyFrameId SlamSystem::TrackFrame(Frame frame, FrameReport* report) {
     report->map_id = map.MapOf(ref);
   }
   report->keyframe = new_kf != kNoKeyFrame;
+  report->map_keyframes = static_cast<int>(map.NumKeyFrames());
+  report->map_points = static_cast<int>(map.NumLandmarks());
   return new_kf;
 }
 

@@ -89,6 +89,10 @@ struct FrameReport {
   double loop_correction_m = 0;             //   how far the pose graph moved the keyframe
   bool maps_merged = false;                 //   it was a merge of two maps
   int num_keypoints = 0;
+  // Size of the atlas (every map) right after tracking this frame; in threaded mode the mapping
+  // thread may still add to it.
+  int map_keyframes = 0;
+  int map_points = 0;
   FrameTimings timings;
   // Why the frame was skipped (its images could not be read: corrupt, wrong type or size, gone);
   // empty for a processed frame. A skipped frame has no pose and is not seen by tracking.

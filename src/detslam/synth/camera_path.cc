@@ -4,13 +4,13 @@
 #include <cmath>
 
 #include "detslam/core/check.h"
+#include "detslam/core/math.h"
 #include "detslam/core/rng.h"
 #include "detslam/synth/options.h"
 
 namespace detslam::synth {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr double kDeg = kPi / 180.0;
 
 // A sinusoid of amplitude `a` and period `period` seconds with phase `phase`.

@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "detslam/core/check.h"
+#include "detslam/core/math.h"
 
 namespace detslam {
 
@@ -139,7 +140,6 @@ void ParseSynthCut(const std::string& text, SynthOptions* options) {
 
 double SynthDepthScale(double bias, int k, int frames) {
   if (bias == 0.0 || frames < 2) return 1.0;
-  constexpr double kPi = 3.14159265358979323846;
   const double s = std::sin(kPi * static_cast<double>(k) / (frames - 1));
   return 1.0 + bias * s * s;
 }

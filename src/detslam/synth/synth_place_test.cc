@@ -28,14 +28,10 @@ namespace fs = std::filesystem;
 using synth_test::Opts;
 using synth_test::Slurp;
 
-fs::path TempDir(const std::string& name) {
-  return synth_test::TempDir("detslam_synth_place_", name);
-}
+using synth_test::CheckError;
 
-// The error message of Check, or "" if the options are valid.
-std::string CheckError(const SynthOptions& o) {
-  std::string error;
-  return o.Check(&error) ? "" : error;
+fs::path PlaceDir(const std::string& name) {
+  return synth_test::TempDir("detslam_synth_place_", name);
 }
 
 // The InputError message `f` throws ("" if it throws nothing).
@@ -218,7 +214,7 @@ TEST(SynthCutTest, CutFramesAreAbsentFromEveryFileAndTheRestUnchanged) {
   o.frames = 9;
   SynthOptions cut = o;
   ParseSynthCut("3:7", &cut);
-  const fs::path full_dir = TempDir("full"), cut_dir = TempDir("cut");
+  const fs::path full_dir = PlaceDir("full"), cut_dir = PlaceDir("cut");
   WriteSequence(o, full_dir.string());
   const SynthStats stats = WriteSequence(cut, cut_dir.string());
   EXPECT_EQ(stats.frames, 5);

@@ -13,10 +13,7 @@ namespace {
 
 using synth_test::Opts;
 
-std::string CheckError(const SynthOptions& o) {
-  std::string error;
-  return o.Check(&error) ? "" : error;
-}
+using synth_test::CheckError;
 
 std::string CoverErrorOf(const std::string& text, SynthOptions* o) {
   try {

@@ -21,6 +21,12 @@ inline SynthOptions Opts(const std::string& preset, uint64_t seed = 1, bool nois
   return o;
 }
 
+// The error message of SynthOptions::Check, or "" if the options are valid.
+inline std::string CheckError(const SynthOptions& o) {
+  std::string error;
+  return o.Check(&error) ? "" : error;
+}
+
 // The whole file as bytes ("" if it cannot be read).
 inline std::string Slurp(const std::filesystem::path& p) {
   std::ifstream in(p, std::ios::binary);

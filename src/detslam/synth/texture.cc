@@ -11,9 +11,13 @@ int Clamp255(double v) { return static_cast<int>(std::clamp(v, 0.0, 255.0)); }
 
 cv::Scalar Jitter(const cv::Scalar& base, double amount, Rng& rng) {
   const double common = rng.Uniform(-amount, amount);
-  return cv::Scalar(Clamp255(base[0] + common + rng.Uniform(-amount, amount) * 0.4),
-                    Clamp255(base[1] + common + rng.Uniform(-amount, amount) * 0.4),
-                    Clamp255(base[2] + common + rng.Uniform(-amount, amount) * 0.4));
+  // One draw per declarator: the order in which a function's arguments are evaluated is
+  // unspecified (gcc and clang differ). Drawn last channel first, the order gcc used when the draws
+  // were arguments, so every sequence generated so far stays byte-identical.
+  const double d2 = rng.Uniform(-amount, amount), d1 = rng.Uniform(-amount, amount),
+               d0 = rng.Uniform(-amount, amount);
+  return cv::Scalar(Clamp255(base[0] + common + d0 * 0.4), Clamp255(base[1] + common + d1 * 0.4),
+                    Clamp255(base[2] + common + d2 * 0.4));
 }
 
 // A colour that differs from `base` by at least `min_contrast` gray levels (lighter or darker).
@@ -27,7 +31,9 @@ cv::Scalar Contrasting(const cv::Scalar& base, double min_contrast, double max_c
 }
 
 cv::Scalar RandomColour(Rng& rng) {
-  return cv::Scalar(rng.UniformInt(20, 235), rng.UniformInt(20, 235), rng.UniformInt(20, 235));
+  // Last channel first, as in Jitter.
+  const int c2 = rng.UniformInt(20, 235), c1 = rng.UniformInt(20, 235), c0 = rng.UniformInt(20, 235);
+  return cv::Scalar(c0, c1, c2);
 }
 
 // Smooth large-scale shading variation (dirt, uneven paint) of +-amplitude gray levels.
