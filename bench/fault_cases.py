@@ -12,6 +12,7 @@ was observed; exits 1 if any case was not. Needs only the Python standard librar
 """
 import json
 import os
+import re
 import shutil
 import struct
 import subprocess
@@ -82,9 +83,12 @@ def run_json(out):
 
 
 def first_line(text, *keys):
-    for line in text.splitlines():
-        if any(k in line for k in keys):
-            return line.strip()
+    """The first line holding keys[0], else the first holding keys[1], ...; without the log's
+    time stamp."""
+    for k in keys:
+        for line in text.splitlines():
+            if k in line:
+                return re.sub(r"^\[[0-9-]+ [0-9:.]+\] ", "", line.strip())
     return ""
 
 
@@ -171,11 +175,11 @@ def delete_during_run(seq, files, out):
 
     def runner(args, out_dir):
         log = out_dir + ".log"
-        args = [a for a in args if a != "--no-progress"]  # the progress line tells when to delete
         t0 = time.time()
         with open(log, "w") as f:
             p = subprocess.Popen([BIN] + args, stdout=f, stderr=subprocess.STDOUT)
-            while p.poll() is None and "[run] 10/" not in open(log, errors="replace").read():
+            # The map is initialised on the first frame: the file list was checked by then.
+            while p.poll() is None and "initialised with" not in open(log, errors="replace").read():
                 time.sleep(0.005)
             if os.path.exists(target):
                 os.remove(target)
@@ -184,7 +188,7 @@ def delete_during_run(seq, files, out):
     return {"runner": runner}
 
 
-case("colour file deleted while the run goes on (frame 70, after frame 10)", delete_during_run,
+case("colour file deleted while the run goes on (frame 70, once frame 0 is tracked)", delete_during_run,
      skipped_ok([70]))
 case("a listed colour file missing before the run (frame 3)",
      lambda seq, f, out: os.remove(f[3][0]) or {},

@@ -22,7 +22,7 @@ if command -v ninja >/dev/null 2>&1; then GEN=(-G Ninja); fi
 if [ -z "${REUSE_BUILD:-}" ]; then
   cmake -S "$ROOT" -B "$BUILD_DIR" "${GEN[@]}" -DCMAKE_CXX_COMPILER=clang++ \
     -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1" \
-    -DDETSLAM_SANITIZE="address,undefined,fuzzer-no-link" -DDETSLAM_FUZZ=ON \
+    -DDETSLAM_SANITIZE="address,undefined" -DDETSLAM_FUZZ=ON \
     -DDETSLAM_BUILD_TESTS=OFF -DDETSLAM_BUILD_BENCH=OFF >/dev/null
 elif ! grep -q "^DETSLAM_FUZZ:BOOL=ON" "$BUILD_DIR/CMakeCache.txt" 2>/dev/null; then
   echo "REUSE_BUILD: $BUILD_DIR is not configured with DETSLAM_FUZZ=ON" >&2

@@ -27,7 +27,7 @@ using testing::TempDir;
 
 // One 300-frame sequence for the command tests (written once per test process).
 const std::string& CommandSequence() {
-  static const std::string dir = WriteStaticSequence("interrupt_cli", 1, 300);
+  static const std::string dir = WriteStaticSequence("interrupt_cli", 1, 200);
   return dir;
 }
 
@@ -99,12 +99,12 @@ TEST(IntegrationInterrupt, SigintAndSigtermStopTheCommandWithItsOutputs) {
     if (threaded) args.push_back("--threaded");
     testing::ChildProcess run(DETSLAM_CLI_PATH, args, log);
     // Without a terminal the progress is a line every 100 frames.
-    ASSERT_TRUE(run.WaitForLog("[run] 100/300", std::chrono::seconds(300))) << ReadFileBytes(log);
+    ASSERT_TRUE(run.WaitForLog("[run] 100/200", std::chrono::seconds(300))) << ReadFileBytes(log);
     run.Signal(sig);
     // A hang guard, not a timing: the stop itself takes well under a second (docs/RELIABILITY.md).
     EXPECT_EQ(run.Wait(std::chrono::seconds(30)), 128 + sig) << ReadFileBytes(log);
     EXPECT_NE(ReadFileBytes(log).find("interrupted after"), std::string::npos) << ReadFileBytes(log);
-    ExpectInterruptedOutputs(out / "run", 100, 300);
+    ExpectInterruptedOutputs(out / "run", 100, 200);
   }
 }
 
@@ -117,7 +117,7 @@ TEST(IntegrationInterrupt, ASecondSignalQuitsAtOnceWithoutTruncatedOutputs) {
                             {"run", "--dataset", seq, "--out", (out / "run").string(),
                              "--segmenter", "none", "--threaded"},
                             log);
-  ASSERT_TRUE(run.WaitForLog("[run] 100/300", std::chrono::seconds(300))) << ReadFileBytes(log);
+  ASSERT_TRUE(run.WaitForLog("[run] 100/200", std::chrono::seconds(300))) << ReadFileBytes(log);
   run.Signal(SIGINT);
   ASSERT_TRUE(run.WaitForLog("again to quit at once", std::chrono::seconds(30)));
   run.Signal(SIGINT);
