@@ -46,7 +46,7 @@ if want S; then
   out="$work/sanitizers.md"
   {
     echo "Each sanitizer build compiles every library, the \`detslam\` command and the tests with"
-    echo "\`-fsanitize=...\` at -O1 (scripts/sanitize.sh); a report aborts its test, so a clean run is"
+    echo "\`-fsanitize=...\` at -O2 (scripts/sanitize.sh, unity build); a report aborts its test, so a clean run is"
     echo "every selected test passing. Suppressions (scripts/sanitizers/*.supp) name system libraries"
     echo "only."
     echo
@@ -57,7 +57,7 @@ if want S; then
     progress "S: scripts/sanitize.sh $kind"
     log="$work/sanitize_$kind.log"
     set +e
-    "$root/scripts/sanitize.sh" "$kind" >"$log" 2>&1
+    UNITY=1 "$root/scripts/sanitize.sh" "$kind" >"$log" 2>&1
     set -e
     python3 - "$log" "$kind" >>"$out" <<'PY'
 import re, sys
@@ -70,8 +70,8 @@ build = re.search(r"\[sanitize\] \w+ build: (\d+) s", text)
 tests = re.findall(r"\[sanitize\] \w+ tests?: (\d+) s", text)
 name = {"address": "AddressSanitizer + UndefinedBehaviorSanitizer + LeakSanitizer",
         "thread": "ThreadSanitizer"}[kind]
-selected = {"address": "all unit tests; integration: runner, interruption, map file, report, "
-                       "vocabulary command, synthetic static run; fr2/desk determinism",
+selected = {"address": "all unit tests; integration: runner, faults, map file, report, "
+                       "vocabulary command; fr2/desk determinism",
             "thread": "bounded queue, stage threads; integration: runner, interruption (not the "
                       "second signal: its _exit with threads running is a thread leak by design); "
                       "fr2/desk threaded and mapping-thread runs"}[kind]
