@@ -106,7 +106,9 @@ failures = 0
 
 
 def case(name, damage, decided):
-    """Decorator-free registration: damage(seq) -> (args, options); decided(result) -> (ok, note)."""
+    """Runs one case. damage(seq, files, out) damages the copy `seq` and returns the setup (extra
+    arguments, a whole command line, a runner, a file size limit, ...); decided(rc, log, run_json,
+    files, out, setup) -> (as decided?, the decided behaviour in words)."""
     global failures
     key = str(len(rows) + 1)
     seq = os.path.join(WORK, "seq" + key)
