@@ -5,6 +5,8 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <memory>
+#include <vector>
 
 #include "detslam/eval/ate.h"
 #include "detslam/pipeline/slam_system.h"
@@ -21,30 +23,46 @@ struct LoopRun {
   double ate_m = 0;
 };
 
-LoopRun RunLoopPreset(const SyntheticSequence& seq, bool loop_closing,
-                      bool global_ba_thread = false) {
-  SlamOptions options;
-  options.loop.enabled = loop_closing;
-  options.global_ba_thread = global_ba_thread;
-  SlamSystem slam(seq.camera(), options);
+struct LoopConfig {
+  bool loop_closing = false;
+  bool global_ba_thread = false;
+};
+
+// Runs one SLAM system per configuration over the sequence, in lockstep: each frame is rendered
+// once and given to every system (rendering is most of a synthetic run's time).
+std::vector<LoopRun> RunLoopPreset(const SyntheticSequence& seq,
+                                   const std::vector<LoopConfig>& configs) {
+  std::vector<std::unique_ptr<SlamSystem>> systems;
+  for (const LoopConfig& c : configs) {
+    SlamOptions options;
+    options.loop.enabled = c.loop_closing;
+    options.global_ba_thread = c.global_ba_thread;
+    systems.push_back(std::make_unique<SlamSystem>(seq.camera(), options));
+  }
   Trajectory gt;
-  LoopRun run;
+  std::vector<LoopRun> runs(configs.size());
   for (int k = 0; k < seq.size(); ++k) {
     const SynthFrame f = seq.Render(k);
     const cv::Mat gray = f.Gray(), depth = f.DepthMetres(seq.camera().depth_map_factor);
-    const FrameReport r = slam.ProcessFrame(k, f.stamp, gray, depth);
-    run.tracked += r.tracking.pose_valid ? 1 : 0;
-    if (r.loop_closed)
-      run.min_agreeing = run.min_agreeing ? std::min(run.min_agreeing, r.loop_agreeing)
-                                          : r.loop_agreeing;
-    ++run.frames;
+    for (size_t i = 0; i < systems.size(); ++i) {
+      const FrameReport r = systems[i]->ProcessFrame(k, f.stamp, gray, depth);
+      LoopRun& run = runs[i];
+      run.tracked += r.tracking.pose_valid ? 1 : 0;
+      if (r.loop_closed)
+        run.min_agreeing = run.min_agreeing ? std::min(run.min_agreeing, r.loop_agreeing)
+                                            : r.loop_agreeing;
+      ++run.frames;
+    }
     gt.push_back({f.stamp, f.world_from_cam});
   }
-  slam.WaitForGlobalBundleAdjustment();
-  run.loops = slam.loops_closed();
-  EXPECT_EQ(slam.loops().size(), static_cast<size_t>(run.loops));
-  run.ate_m = ComputeAte(gt, slam.FrameTrajectory(), AteOptions()).error_m.rmse;
-  return run;
+  for (size_t i = 0; i < systems.size(); ++i) {
+    SlamSystem& slam = *systems[i];
+    slam.WaitForGlobalBundleAdjustment();
+    runs[i].loops = slam.loops_closed();
+    EXPECT_EQ(slam.loops().size(), static_cast<size_t>(runs[i].loops));
+    runs[i].ate_m = ComputeAte(gt, slam.FrameTrajectory(), AteOptions()).error_m.rmse;
+  }
+  return runs;
 }
 
 TEST(IntegrationLoopClosing, ClosesTheLoopOfTheLoopPreset) {
@@ -56,17 +74,19 @@ TEST(IntegrationLoopClosing, ClosesTheLoopOfTheLoopPreset) {
   // for a few of them).
   so.frames = 1200;
   const SyntheticSequence seq(so);
-  const LoopRun without = RunLoopPreset(seq, false);
-  const LoopRun with = RunLoopPreset(seq, true);
+  // Without loop closing, with it, and with the global bundle adjustment in a thread of its own
+  // (as with a mapping thread: frames go on while it runs, its result is merged).
+  const std::vector<LoopRun> runs = RunLoopPreset(seq, {{false, false}, {true, false}, {true, true}});
+  const LoopRun& without = runs[0];
+  const LoopRun& with = runs[1];
+  const LoopRun& threaded = runs[2];
   EXPECT_EQ(without.loops, 0);
   EXPECT_GE(with.loops, 1);
   EXPECT_GE(with.min_agreeing, SlamOptions().loop.consistent_detections);
   EXPECT_EQ(SlamOptions().loop.consistent_detections, 3);
   EXPECT_EQ(with.tracked, with.frames);
   EXPECT_LT(with.ate_m, 0.6 * without.ate_m) << "ATE with loop closing " << with.ate_m << " m, without " << without.ate_m << " m";
-  // The global bundle adjustment in a thread of its own (as with a mapping thread): frames go on
-  // while it runs, its result is merged; the loop must be as well corrected.
-  const LoopRun threaded = RunLoopPreset(seq, true, true);
+  // The loop must be as well corrected by the global bundle adjustment thread.
   EXPECT_GE(threaded.loops, 1);
   EXPECT_EQ(threaded.tracked, threaded.frames);
   EXPECT_LT(threaded.ate_m, 0.6 * without.ate_m) << "ATE with the global BA thread " << threaded.ate_m << " m";
