@@ -18,8 +18,10 @@
 #     for 120 s = hung, stacks dumped) sampling resident memory and the atlas size
 #     (docs/reliability_soak.svg); then two sequential runs of its first SOAK_SEQ_FRAMES frames
 #     whose outputs must be byte-identical (section soak).
+#  C. CI time: a clean clone of the committed HEAD with ../shared beside it runs .ci/run as CI does
+#     (CI=true, no compiler cache): each stage's seconds, the total, the result (section ci).
 # Usage: bench/bench_reliability.sh [path/to/detslam]
-#   (env: PARTS="S F I X K", TRIALS=3, INT_FRAMES=400, FUZZ_RUNS=100000, SOAK_FRAMES=20000,
+#   (env: PARTS="S F I X K" (C only when named), TRIALS=3, INT_FRAMES=400, FUZZ_RUNS=100000, SOAK_FRAMES=20000,
 #    SOAK_SEQ_FRAMES=1000)
 set -euo pipefail
 here="$(cd "$(dirname "$0")" && pwd)"
@@ -48,7 +50,9 @@ if want S; then
     echo "Each sanitizer build compiles every library, the \`detslam\` command and the tests with"
     echo "\`-fsanitize=...\` at -O2 (scripts/sanitize.sh, unity build); a report aborts its test, so a clean run is"
     echo "every selected test passing. Suppressions (scripts/sanitizers/*.supp) name system libraries"
-    echo "only."
+    echo "only. Left uninstrumented, for speed: the synthetic generator under ThreadSanitizer (it runs"
+    echo "on one thread there) and, with clang only, UBSan in the generator's renderer.cc (it keeps"
+    echo "AddressSanitizer)."
     echo
     echo "| build | tests selected | passed | failed | build s | tests s |"
     echo "|---|---|---:|---:|---:|---:|"
@@ -255,4 +259,45 @@ if want K; then
   publish_doc soak "$out"
   [ "$soak_rc" -eq 0 ] && [ "$identical" = yes ] ||
     { echo "bench_reliability: the soak run failed" >&2; exit 1; }
+fi
+
+if want C; then
+  progress "C: .ci/run on a clean clone of HEAD ($(git -C "$root" rev-parse --short HEAD))"
+  [ -z "$(git -C "$root" status --porcelain)" ] ||
+    progress "C: the working tree has uncommitted changes; the clone has only what is committed"
+  shared="$(cd "$root/../shared" 2>/dev/null && pwd)" ||
+    { echo "bench_reliability: part C needs ../shared beside the repository" >&2; exit 1; }
+  mkdir -p "$work/ci"
+  git clone -q "$root" "$work/ci/repo"
+  ln -sfn "$shared" "$work/ci/shared"
+  start=$(date +%s)
+  set +e
+  (cd "$work/ci/repo" && unset CMAKE_CXX_COMPILER_LAUNCHER &&
+    CI=true CCACHE_DISABLE=1 bash .ci/run) >"$work/ci.log" 2>&1
+  ci_rc=$?
+  set -e
+  total=$(( $(date +%s) - start ))
+  out="$work/ci.md"
+  {
+    echo "\`.ci/run\` on a clean clone of commit $(git -C "$root" rev-parse --short HEAD) with ../shared beside it, as CI"
+    echo "runs it (CI=true, no compiler cache, Debian packages already installed). Seconds per stage"
+    echo "(each stage builds its own folder from scratch, then runs its tests):"
+    echo
+    python3 - "$work/ci.log" "$total" "$ci_rc" <<'PY'
+import re, sys
+text = open(sys.argv[1]).read()
+total, rc = int(sys.argv[2]), int(sys.argv[3])
+stages = re.findall(r"^\[ci\] (.+) \((\d+) s since the start\)$", text, re.M)
+print("| stage | seconds |")
+print("|---|---:|")
+for (name, t0), (_, t1) in zip(stages, stages[1:]):
+    print(f"| {name} | {int(t1) - int(t0)} |")
+print(f"| **whole .ci/run** (with its package checks) | **{total}** ({total / 60:.1f} min) |")
+print()
+print(f"Result: {'passed' if rc == 0 else f'FAILED (exit status {rc})'}.")
+PY
+    echo
+  } >"$out"
+  publish_doc ci "$out"
+  [ "$ci_rc" -eq 0 ] || { tail -50 "$work/ci.log" >&2; echo "bench_reliability: .ci/run failed" >&2; exit 1; }
 fi

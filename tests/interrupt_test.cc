@@ -25,7 +25,7 @@ using integration::RunJson;
 using integration::WriteStaticSequence;
 using testing::TempDir;
 
-// One 300-frame sequence for the command tests (written once per test process).
+// One 200-frame sequence for the command tests (written once per test process).
 const std::string& CommandSequence() {
   static const std::string dir = WriteStaticSequence("interrupt_cli", 1, 200);
   return dir;
@@ -48,7 +48,7 @@ void ExpectInterruptedOutputs(const fs::path& out, size_t min_frames, size_t max
 }
 
 TEST(IntegrationInterrupt, AStopRequestEndsTheRunWithTheOutputsSoFar) {
-  const std::string seq = WriteStaticSequence("interrupt_lib", 1, 120);
+  const std::string seq = WriteStaticSequence("interrupt_lib", 1, 60);
   const RgbdDataset dataset = RgbdDataset::Open(seq, {});
   const Settings settings = PresetForDataset(seq);
   for (const auto& [threaded, mapping_thread] :
@@ -65,15 +65,15 @@ TEST(IntegrationInterrupt, AStopRequestEndsTheRunWithTheOutputsSoFar) {
     const RunSummary s = detslam::Run(
         dataset, settings, options,
         [&](size_t done, size_t, const FrameReport&) {
-          if (done == 30) stop = true;
+          if (done == 20) stop = true;
         },
         nullptr);
     EXPECT_TRUE(s.interrupted);
     if (!threaded) {
-      EXPECT_EQ(s.frames, 30u);  // sequential: the frame in progress was the 30th
+      EXPECT_EQ(s.frames, 20u);  // sequential: the frame in progress was the 20th
     }
     EXPECT_EQ(s.tracked, s.frames);
-    ExpectInterruptedOutputs(options.out_dir, 30, 120);
+    ExpectInterruptedOutputs(options.out_dir, 20, 60);
     EXPECT_TRUE(fs::exists(options.save_map));
   }
   // Without a stop request the same run is complete and says so.
@@ -84,7 +84,7 @@ TEST(IntegrationInterrupt, AStopRequestEndsTheRunWithTheOutputsSoFar) {
   options.stop = &stop;
   const RunSummary s = detslam::Run(dataset, settings, options, nullptr, nullptr);
   EXPECT_FALSE(s.interrupted);
-  EXPECT_EQ(s.frames, 120u);
+  EXPECT_EQ(s.frames, 60u);
   EXPECT_FALSE(RunJson(options.out_dir)["interrupted"].get<bool>());
 }
 
