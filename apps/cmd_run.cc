@@ -1,5 +1,5 @@
-// detslam run: SLAM over a TUM/Bonn-layout RGB-D folder (sequential by default; --threaded runs one
-// thread per stage).
+// detslam run: SLAM over a TUM/Bonn-layout RGB-D folder or a ROS 1 bag (sequential by default;
+// --threaded runs one thread per stage).
 #include <unistd.h>
 
 #include <atomic>
@@ -12,6 +12,7 @@
 #include "commands.h"
 #include "detslam/core/check.h"
 #include "detslam/io/dataset.h"
+#include "detslam/io/rosbag_source.h"
 #include "detslam/io/settings.h"
 #include "detslam/pipeline/runner.h"
 #include "detslam/pipeline/settings_keys.h"
@@ -23,6 +24,8 @@ namespace {
 
 struct RunArgs {
   std::string dataset;
+  std::string rosbag;
+  RosbagOptions bag;  // topics
   std::string config;
   std::string out = "out";
   std::string association;
@@ -113,11 +116,26 @@ class StopSignals {
 
 void Run(const RunArgs& a) {
   namespace fs = std::filesystem;
-  DatasetOptions dopt;
-  dopt.max_difference_s = a.max_dt;
-  dopt.association_file = a.association;
-  const RgbdDataset dataset = RgbdDataset::Open(a.dataset, dopt);
-  Settings settings = a.config.empty() ? PresetForDataset(a.dataset) : ReadSettings(a.config);
+  if (a.dataset.empty() == a.rosbag.empty()) {
+    throw InputError("name the frames to run on: --dataset DIR (TUM layout) or --rosbag FILE");
+  }
+  std::unique_ptr<RgbdSource> source;
+  Settings settings;
+  if (!a.rosbag.empty()) {
+    if (!a.association.empty()) throw InputError("--association is for --dataset folders only");
+    RosbagOptions bopt = a.bag;
+    bopt.max_difference_s = a.max_dt;
+    auto bag = std::make_unique<RosbagSource>(RosbagSource::Open(a.rosbag, bopt));
+    settings = a.config.empty() ? SettingsForBag(a.rosbag, bag->camera_info()) : ReadSettings(a.config);
+    source = std::move(bag);
+  } else {
+    DatasetOptions dopt;
+    dopt.max_difference_s = a.max_dt;
+    dopt.association_file = a.association;
+    source = std::make_unique<RgbdDataset>(RgbdDataset::Open(a.dataset, dopt));
+    settings = a.config.empty() ? PresetForDataset(a.dataset) : ReadSettings(a.config);
+  }
+  const RgbdSource& dataset = *source;
   ApplySettingOverrides(a.overrides, &settings);
   const ResolvedSettings resolved = ResolveSettings(settings);  // rejects bad or unknown keys
   RunOptions options;
@@ -144,16 +162,16 @@ void Run(const RunArgs& a) {
   std::unique_ptr<Segmenter> segmenter;
   if (spec.empty()) {
     try {
-      segmenter = MakeSegmenter("dnn", a.dataset, resolved.segmenter, models_dir);
+      segmenter = MakeSegmenter("dnn", dataset.name(), resolved.segmenter, models_dir);
       spec = "dnn";
     } catch (const InputError& e) {
       std::fprintf(stderr, "note: no dynamic-object segmentation (pass --segmenter dnn|masks:DIR|gt|none): %s\n", e.what());
       spec = "none";
     }
   } else {
-    segmenter = MakeSegmenter(spec, a.dataset, resolved.segmenter, models_dir);
+    segmenter = MakeSegmenter(spec, dataset.name(), resolved.segmenter, models_dir);
   }
-  std::printf("detslam run (%s, segmenter %s): %zu frames from %s (settings: %s)\n", a.threaded ? "threaded" : "sequential", spec.c_str(), dataset.size(), dataset.dir().c_str(),
+  std::printf("detslam run (%s, segmenter %s): %zu frames from %s (settings: %s)\n", a.threaded ? "threaded" : "sequential", spec.c_str(), dataset.size(), dataset.name().c_str(),
               settings.source.c_str());
   ProgressBar bar(!a.no_progress);
   options.stop = &g_stop;
@@ -180,7 +198,7 @@ void Run(const RunArgs& a) {
   if (!a.save_map.empty()) std::printf("map file: %s (%.1f MB)\n", a.save_map.c_str(), s.map_file_bytes / 1e6);
   if (!dataset.groundtruth_path().empty()) {
     std::printf("evaluate: detslam eval --gt %s --est %s --frames %s\n", dataset.groundtruth_path().c_str(),
-                (out / "trajectory.txt").c_str(), dataset.dir().c_str());
+                (out / "trajectory.txt").c_str(), dataset.name().c_str());
   }
   if (s.interrupted) {
     std::fflush(stdout);
@@ -192,9 +210,17 @@ void Run(const RunArgs& a) {
 
 void AddRunCommand(CLI::App& app) {
   auto args = std::make_shared<RunArgs>();
-  auto* cmd = app.add_subcommand("run", "Run RGB-D SLAM on a TUM/Bonn-layout folder");
-  cmd->add_option("--dataset", args->dataset, "Folder with rgb.txt, depth.txt (and groundtruth.txt)")->required();
-  cmd->add_option("--config", args->config, "ORB-SLAM3-style settings YAML (default: preset from the folder name)");
+  auto* cmd = app.add_subcommand("run", "Run RGB-D SLAM on a TUM/Bonn-layout folder or a ROS 1 bag");
+  auto* dataset = cmd->add_option("--dataset", args->dataset, "Folder with rgb.txt, depth.txt (and groundtruth.txt)");
+  cmd->add_option("--rosbag", args->rosbag,
+                  "ROS 1 bag (format 2.0; uncompressed, bz2 or lz4 chunks) with colour and depth sensor_msgs/Image topics, instead of --dataset")
+      ->excludes(dataset);
+  cmd->add_option("--rgb-topic", args->bag.rgb_topic, "With --rosbag: colour topic (rgb8, bgr8, rgba8, bgra8, mono8)")->capture_default_str();
+  cmd->add_option("--depth-topic", args->bag.depth_topic, "With --rosbag: depth topic (32FC1 metres or 16UC1 millimetres)")->capture_default_str();
+  cmd->add_option("--camera-info-topic", args->bag.camera_info_topic,
+                  "With --rosbag: camera intrinsics, used when there is no --config and the bag's file name names no preset")
+      ->capture_default_str();
+  cmd->add_option("--config", args->config, "ORB-SLAM3-style settings YAML (default: preset from the folder or bag name; for a bag otherwise its camera info)");
   cmd->add_option("--out", args->out, "Output folder")->capture_default_str();
   cmd->add_option("--association", args->association, "Explicit rgb/depth association file");
   cmd->add_option("--max-dt", args->max_dt, "rgb/depth association window in seconds")->capture_default_str();

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Regenerates the binary and generated seeds of fuzz/corpus (map file, vocabulary, run.json,
 # settings) with the built `detslam` command; the hand-written text seeds stay as they are.
-# Usage: fuzz/make_corpus.sh [path/to/detslam]
+# Usage: fuzz/make_corpus.sh [path/to/detslam [path/to/make_bag_seeds]]
+# (make_bag_seeds is built with the fuzz targets: scripts/fuzz.sh, build-asan/fuzz/.)
 set -euo pipefail
 here="$(cd "$(dirname "$0")" && pwd)"
 bin="${1:-$(dirname "$here")/build/bin/detslam}"
@@ -33,4 +34,11 @@ rm -f "$here/corpus/vocabulary/tiny.dslvoc"
 cp "$work/run0/run.json" "$here/corpus/run_log/three_frames.json"
 { cat "$work/small800.yaml"; printf '\n===\nDynamic.Alpha=0.2\nTracking.KeyFrameFarPoints=40\n'; } \
   >"$here/corpus/settings/synth_v1.yaml"
+seeds="${2:-$(dirname "$here")/build-asan/fuzz/make_bag_seeds}"
+if [ -x "$seeds" ]; then
+  rm -f "$here"/corpus/rosbag/*.bag
+  "$seeds" "$here/corpus/rosbag"
+else
+  echo "note: $seeds is not built; corpus/rosbag left as it is"
+fi
 ls -l "$here"/corpus/*/

@@ -12,7 +12,7 @@
 set -euo pipefail
 ROOT=$(cd "$(dirname "$0")/.." && pwd)
 seconds=${1:-10}
-targets=${FUZZ_TARGETS:-"trajectory dataset mask_list run_log vocabulary map_file settings"}
+targets=${FUZZ_TARGETS:-"trajectory dataset mask_list run_log vocabulary map_file settings rosbag"}
 BUILD_DIR=${BUILD_DIR:-"$ROOT/build-fuzz"}
 JOBS=${JOBS:-$(nproc)}
 "$ROOT/scripts/install_deps.sh"

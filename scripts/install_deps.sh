@@ -3,7 +3,7 @@
 set -euo pipefail
 PACKAGES=(build-essential cmake ninja-build pkg-config
   libopencv-dev libeigen3-dev libceres-dev libcli11-dev libspdlog-dev libfmt-dev
-  nlohmann-json3-dev libyaml-cpp-dev libgtest-dev libgmock-dev libbenchmark-dev
+  nlohmann-json3-dev libyaml-cpp-dev libbz2-dev liblz4-dev libgtest-dev libgmock-dev libbenchmark-dev
   python3-numpy)
 missing=()
 for p in "${PACKAGES[@]}"; do

@@ -106,10 +106,6 @@ std::string DescribeMat(const cv::Mat& m) {
   return os.str();
 }
 
-std::string SizeText(int width, int height) {
-  return std::to_string(width) + "x" + std::to_string(height);
-}
-
 }  // namespace
 
 bool DatasetOptions::Check(std::string* error) const {
@@ -202,8 +198,8 @@ RgbdImages RgbdDataset::Load(size_t i, const PinholeCamera& camera) const {
   }
   if (out.bgr.cols != camera.width || out.bgr.rows != camera.height) {
     throw InputError(f.rgb_path, 0,
-                     "colour image is " + SizeText(out.bgr.cols, out.bgr.rows) +
-                         " but the camera settings say " + SizeText(camera.width, camera.height));
+                     "colour image is " + ImageSizeText(out.bgr.cols, out.bgr.rows) +
+                         " but the camera settings say " + ImageSizeText(camera.width, camera.height));
   }
   // OpenCV decodes PNG/JPEG into BGR order regardless of Camera.RGB, so the conversion is fixed.
   cv::cvtColor(out.bgr, out.gray, cv::COLOR_BGR2GRAY);
@@ -216,9 +212,9 @@ RgbdImages RgbdDataset::Load(size_t i, const PinholeCamera& camera) const {
   }
   if (depth.size() != out.bgr.size()) {
     throw InputError(f.depth_path, 0,
-                     "depth image is " + SizeText(depth.cols, depth.rows) +
+                     "depth image is " + ImageSizeText(depth.cols, depth.rows) +
                          " but its colour image " + f.rgb_path + " is " +
-                         SizeText(out.bgr.cols, out.bgr.rows));
+                         ImageSizeText(out.bgr.cols, out.bgr.rows));
   }
   if (!(camera.depth_map_factor > 0)) {
     throw InputError(f.depth_path, 0, "camera DepthMapFactor must be positive to convert depth");

@@ -11,6 +11,7 @@
 
 #include "detslam/core/camera.h"
 #include "detslam/core/timestamp.h"
+#include "detslam/io/rgbd_source.h"
 
 namespace detslam {
 
@@ -31,31 +32,27 @@ struct RgbdFrameRef {
   std::string depth_path;
 };
 
-struct RgbdImages {
-  cv::Mat bgr;      // CV_8UC3, OpenCV channel order
-  cv::Mat gray;     // CV_8UC1
-  cv::Mat depth_m;  // CV_32FC1, metres, 0 = missing
-};
-
-class RgbdDataset {
+class RgbdDataset : public RgbdSource {
  public:
   // Reads the lists and associates the frames. Throws InputError (naming the file and line) on a
   // missing folder or list, a malformed line, stamps out of order, a listed image that does not
   // exist, or an empty result.
   static RgbdDataset Open(const std::string& dir, const DatasetOptions& options);
 
-  size_t size() const { return frames_.size(); }
+  size_t size() const override { return frames_.size(); }
+  Timestamp stamp(size_t i) const override { return frame(i).rgb_stamp; }
   const RgbdFrameRef& frame(size_t i) const;
   const std::vector<RgbdFrameRef>& frames() const { return frames_; }
   const std::string& dir() const { return dir_; }
+  const std::string& name() const override { return dir_; }
   // Absolute path of groundtruth.txt, or empty if the folder has none.
-  std::string groundtruth_path() const;
+  std::string groundtruth_path() const override;
 
   // Decodes frame i. Colour is converted to 8-bit BGR (grayscale and 4-channel images are
   // converted); depth must be a 16-bit single-channel image of the colour image's size, and both
   // must be camera.width x camera.height. depth_m = value / camera.depth_map_factor. Throws
   // InputError naming the offending image file.
-  RgbdImages Load(size_t i, const PinholeCamera& camera) const;
+  RgbdImages Load(size_t i, const PinholeCamera& camera) const override;
 
  private:
   RgbdDataset() = default;

@@ -28,11 +28,11 @@ nlohmann::json StatsJson(const ErrorStats& s) {
           {"std_ms", s.std},  {"min_ms", s.min},       {"max_ms", s.max}};
 }
 
-void WriteOutputs(const RgbdDataset& dataset, const Settings& settings, const RunOptions& options,
+void WriteOutputs(const RgbdSource& dataset, const Settings& settings, const RunOptions& options,
                   const SlamSystem& slam, RunSummary& summary) {
   namespace fs = std::filesystem;
   const fs::path out(options.out_dir);
-  const std::string header = "detslam trajectory (world_from_camera) of " + dataset.dir() +
+  const std::string header = "detslam trajectory (world_from_camera) of " + dataset.name() +
                              "\nsettings: " + settings.source;
   // The main map's frames go to trajectory.txt; maps that never merged into it to files of their
   // own (never mixed in). Those of an earlier run in the same folder are removed first.
@@ -62,7 +62,7 @@ void WriteOutputs(const RgbdDataset& dataset, const Settings& settings, const Ru
                                                : trajectories.by_map.at(trajectories.main_map),
                      header);
   WriteTumTrajectory((out / "keyframes.txt").string(), slam.KeyFrameTrajectory(),
-                     "detslam keyframes of " + dataset.dir());
+                     "detslam keyframes of " + dataset.name());
   std::vector<Eigen::Vector3d> points;  // of the main map (the others are in frames of their own)
   {
     const MapStore::ReadAccess map = slam.ReadMap();
@@ -76,7 +76,7 @@ void WriteOutputs(const RgbdDataset& dataset, const Settings& settings, const Ru
   WritePointCloudPly((out / "map.ply").string(), points, {});
   if (!options.save_map.empty()) summary.map_file_bytes = slam.SaveMap(options.save_map);
   nlohmann::json j;
-  j["dataset"] = dataset.dir();
+  j["dataset"] = dataset.name();
   j["settings"] = settings.source;
   j["effective_settings"] = EffectiveSettingsJson(settings, options);
   j["mode"] = options.threaded ? (options.mapping_thread ? "threaded (mapping thread)" : "threaded")
@@ -342,12 +342,12 @@ class RunRecorder {
     summary_.loaded_landmarks = info.landmarks;
   }
 
-  RunSummary Finish(const RgbdDataset& dataset, const Settings& settings, const RunOptions& options,
+  RunSummary Finish(const RgbdSource& dataset, const Settings& settings, const RunOptions& options,
                     SlamSystem& slam, std::chrono::steady_clock::time_point start,
                     const Segmenter* segmenter) {
     if (segmenter != nullptr) summary_.segmenter = segmenter->name();
     if (summary_.frames > 0 && summary_.skipped == summary_.frames) {
-      throw InputError("no frame of " + dataset.dir() + " could be read; the first: " +
+      throw InputError("no frame of " + dataset.name() + " could be read; the first: " +
                        summary_.reports.front().skipped);
     }
     summary_.segmentation = ComputeErrorStats(seg_);
@@ -384,7 +384,7 @@ class RunRecorder {
   std::vector<double> seg_, ext_, trk_, total_ms_;
 };
 
-size_t FrameCount(const RgbdDataset& dataset, const RunOptions& options) {
+size_t FrameCount(const RgbdSource& dataset, const RunOptions& options) {
   size_t n = dataset.size();
   if (options.max_frames >= 0) n = std::min(n, static_cast<size_t>(options.max_frames));
   return n;
@@ -403,7 +403,7 @@ struct LoadedFrame {
   double segmentation_ms = 0;
 };
 
-LoadedFrame LoadAndSegment(const RgbdDataset& dataset, const Settings& settings, size_t i,
+LoadedFrame LoadAndSegment(const RgbdSource& dataset, const Settings& settings, size_t i,
                            SlamSystem* slam) {
   LoadedFrame f;
   f.index = static_cast<int64_t>(i);
@@ -415,7 +415,7 @@ LoadedFrame LoadAndSegment(const RgbdDataset& dataset, const Settings& settings,
   }
   SegmenterInput in;
   in.index = f.index;
-  in.stamp = dataset.frame(i).rgb_stamp;
+  in.stamp = dataset.stamp(i);
   in.bgr = f.images.bgr;
   in.depth_m = f.images.depth_m;
   FrameInstances dynamic = slam->SegmentFrame(in, f.images.gray);
@@ -426,25 +426,25 @@ LoadedFrame LoadAndSegment(const RgbdDataset& dataset, const Settings& settings,
 }
 
 // The report of a frame whose images could not be read (f.unreadable is set).
-FrameReport SkippedReport(const RgbdDataset& dataset, const LoadedFrame& f) {
+FrameReport SkippedReport(const RgbdSource& dataset, const LoadedFrame& f) {
   FrameReport r;
   r.index = f.index;
-  r.stamp = dataset.frame(static_cast<size_t>(f.index)).rgb_stamp;
+  r.stamp = dataset.stamp(static_cast<size_t>(f.index));
   r.skipped = f.unreadable;
   return r;
 }
 
-Frame Extract(const SlamSystem& slam, const RgbdDataset& dataset, const LoadedFrame& f,
+Frame Extract(const SlamSystem& slam, const RgbdSource& dataset, const LoadedFrame& f,
               FrameReport* report) {
   report->segmentation_ms = f.segmentation_ms;
-  return slam.ExtractFrame(f.index, dataset.frame(static_cast<size_t>(f.index)).rgb_stamp,
+  return slam.ExtractFrame(f.index, dataset.stamp(static_cast<size_t>(f.index)),
                            f.images.gray, f.images.depth_m, cv::Mat(), report,
                            f.segmented ? &f.instances : nullptr);
 }
 
 }  // namespace
 
-RunSummary RunSequential(const RgbdDataset& dataset, const Settings& settings,
+RunSummary RunSequential(const RgbdSource& dataset, const Settings& settings,
                          const RunOptions& options, const ProgressFn& progress,
                          Segmenter* segmenter) {
   const auto start = std::chrono::steady_clock::now();
@@ -469,7 +469,7 @@ RunSummary RunSequential(const RgbdDataset& dataset, const Settings& settings,
   return recorder.Finish(dataset, settings, options, slam, start, segmenter);
 }
 
-RunSummary RunThreaded(const RgbdDataset& dataset, const Settings& settings,
+RunSummary RunThreaded(const RgbdSource& dataset, const Settings& settings,
                        const RunOptions& options, const ProgressFn& progress,
                        Segmenter* segmenter) {
   const auto start = std::chrono::steady_clock::now();
@@ -552,7 +552,7 @@ RunSummary RunThreaded(const RgbdDataset& dataset, const Settings& settings,
   return recorder.Finish(dataset, settings, options, slam, start, segmenter);
 }
 
-RunSummary Run(const RgbdDataset& dataset, const Settings& settings, const RunOptions& options,
+RunSummary Run(const RgbdSource& dataset, const Settings& settings, const RunOptions& options,
                const ProgressFn& progress, Segmenter* segmenter) {
   return options.threaded ? RunThreaded(dataset, settings, options, progress, segmenter)
                           : RunSequential(dataset, settings, options, progress, segmenter);

@@ -67,11 +67,11 @@ using ProgressFn = std::function<void(size_t done, size_t total, const FrameRepo
 
 // Sequential mode: one frame at a time through extraction, tracking and local mapping.
 // Deterministic for a given dataset, settings and seed.
-// In every mode a frame whose images cannot be read (RgbdDataset::Load throws InputError: corrupt
+// In every mode a frame whose images cannot be read (RgbdSource::Load throws InputError: corrupt
 // or missing file, wrong type or size) is skipped with a warning and listed in run.json
 // (skipped_frames); the run goes on. When no frame at all can be read the run throws InputError
 // with the first frame's reason and writes nothing.
-RunSummary RunSequential(const RgbdDataset& dataset, const Settings& settings,
+RunSummary RunSequential(const RgbdSource& dataset, const Settings& settings,
                          const RunOptions& options, const ProgressFn& progress = nullptr,
                          Segmenter* segmenter = nullptr);
 
@@ -81,7 +81,7 @@ RunSummary RunSequential(const RgbdDataset& dataset, const Settings& settings,
 // (results then depend on timing); without it, mapping runs in the tracking thread and the
 // trajectory equals the sequential one. An exception in any stage stops the others and is
 // rethrown here.
-RunSummary RunThreaded(const RgbdDataset& dataset, const Settings& settings,
+RunSummary RunThreaded(const RgbdSource& dataset, const Settings& settings,
                        const RunOptions& options, const ProgressFn& progress = nullptr,
                        Segmenter* segmenter = nullptr);
 
@@ -89,7 +89,7 @@ RunSummary RunThreaded(const RgbdDataset& dataset, const Settings& settings,
 // With a segmenter, the Det-SLAM stage (options.slam.dynamic) segments every
 // `segment_every`-th frame (masks follow the optical flow in between) and rejects keypoints on
 // dynamic objects; in threaded mode segmentation runs in the loading thread.
-RunSummary Run(const RgbdDataset& dataset, const Settings& settings, const RunOptions& options,
+RunSummary Run(const RgbdSource& dataset, const Settings& settings, const RunOptions& options,
                const ProgressFn& progress = nullptr, Segmenter* segmenter = nullptr);
 
 }  // namespace detslam
