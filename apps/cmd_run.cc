@@ -121,12 +121,14 @@ void Run(const RunArgs& a) {
   }
   std::unique_ptr<RgbdSource> source;
   Settings settings;
+  bool bag_has_tf = false;
   if (!a.rosbag.empty()) {
     if (!a.association.empty()) throw InputError("--association is for --dataset folders only");
     RosbagOptions bopt = a.bag;
     bopt.max_difference_s = a.max_dt;
     auto bag = std::make_unique<RosbagSource>(RosbagSource::Open(a.rosbag, bopt));
     settings = a.config.empty() ? SettingsForBag(a.rosbag, bag->camera_info()) : ReadSettings(a.config);
+    bag_has_tf = bag->has_tf();
     source = std::move(bag);
   } else {
     DatasetOptions dopt;
@@ -199,6 +201,11 @@ void Run(const RunArgs& a) {
   if (!dataset.groundtruth_path().empty()) {
     std::printf("evaluate: detslam eval --gt %s --est %s --frames %s\n", dataset.groundtruth_path().c_str(),
                 (out / "trajectory.txt").c_str(), dataset.name().c_str());
+  }
+  if (bag_has_tf) {
+    std::printf("ground truth (if the bag's tf holds it): detslam rosbag groundtruth %s --out %s, then detslam eval --gt %s --est %s\n",
+                a.rosbag.c_str(), (out / "groundtruth.txt").c_str(), (out / "groundtruth.txt").c_str(),
+                (out / "trajectory.txt").c_str());
   }
   if (s.interrupted) {
     std::fflush(stdout);

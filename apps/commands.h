@@ -23,5 +23,6 @@ void AddReportCommand(CLI::App& app);
 void AddSettingsCommand(CLI::App& app);
 void AddVocabCommand(CLI::App& app);
 void AddMapCommand(CLI::App& app);
+void AddRosbagCommand(CLI::App& app);
 
 }  // namespace detslam::app

@@ -27,6 +27,7 @@ int main(int argc, char** argv) {
   detslam::app::AddSettingsCommand(app);
   detslam::app::AddVocabCommand(app);
   detslam::app::AddMapCommand(app);
+  detslam::app::AddRosbagCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

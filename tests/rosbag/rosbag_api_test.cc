@@ -5,6 +5,7 @@
 #include <rosbag/bag.h>
 #include <sensor_msgs/CameraInfo.h>
 #include <sensor_msgs/Image.h>
+#include <tf2_msgs/TFMessage.h>
 
 #include <cmath>
 #include <cstring>
@@ -17,6 +18,7 @@
 #include "detslam/io/dataset.h"
 #include "detslam/io/rosbag_source.h"
 #include "detslam/io/settings.h"
+#include "detslam/io/trajectory.h"
 #include "detslam/pipeline/runner.h"
 #include "detslam/synth/writer.h"
 #include "support/cli_runner.h"
@@ -50,6 +52,29 @@ sensor_msgs::Image ImageMsg(Timestamp t, const cv::Mat& m, const std::string& en
   return im;
 }
 
+// The fixed transform from the camera's optical frame to the tracked body, as in TUM's bags
+// (/kinect -> /openni_rgb_optical_frame on /tf_static).
+Rigid3d KinectFromCamera() {
+  return Rigid3d(Eigen::Quaterniond(Eigen::AngleAxisd(0.3, Eigen::Vector3d(1, 2, 3).normalized())),
+                 Eigen::Vector3d(0.01, -0.045, 0.02));
+}
+
+geometry_msgs::TransformStamped TransformMsg(const std::string& parent, const std::string& child,
+                                             Timestamp t, const Rigid3d& parent_from_child) {
+  geometry_msgs::TransformStamped m;
+  m.header.stamp = RosTime(t);
+  m.header.frame_id = parent;
+  m.child_frame_id = child;
+  m.transform.translation.x = parent_from_child.translation().x();
+  m.transform.translation.y = parent_from_child.translation().y();
+  m.transform.translation.z = parent_from_child.translation().z();
+  m.transform.rotation.x = parent_from_child.rotation().x();
+  m.transform.rotation.y = parent_from_child.rotation().y();
+  m.transform.rotation.z = parent_from_child.rotation().z();
+  m.transform.rotation.w = parent_from_child.rotation().w();
+  return m;
+}
+
 // Writes the folder sequence `dir` as a bag with TUM's topic names, the way `rosbag record`
 // stores a Kinect driver's output (receipt times a little after the header stamps).
 void WriteBag(const std::string& dir, const std::string& path, uint32_t compression,
@@ -59,6 +84,18 @@ void WriteBag(const std::string& dir, const std::string& path, uint32_t compress
   rosbag::Bag bag;
   bag.open(path, rosbag::bagmode::Write);
   bag.setCompression(static_cast<rosbag::compression::CompressionType>(compression));
+  // Ground truth as TUM's bags carry it: the tracked body in /world on /tf (here at the frames'
+  // stamps), the body-to-camera transform once on /tf_static.
+  tf2_msgs::TFMessage fixed;
+  fixed.transforms.push_back(
+      TransformMsg("/kinect", "/camera_rgb_optical_frame", Timestamp{0}, KinectFromCamera()));
+  bag.write("/tf_static", RosTime(ds.frame(0).rgb_stamp), fixed);
+  for (const StampedPose& p : ReadTumTrajectory((fs::path(dir) / "groundtruth.txt").string())) {
+    tf2_msgs::TFMessage moving;
+    moving.transforms.push_back(TransformMsg("/world", "/kinect", p.stamp,
+                                             p.world_from_cam * KinectFromCamera().Inverse()));
+    bag.write("/tf", RosTime(p.stamp), moving);
+  }
   for (size_t i = 0; i < ds.size(); ++i) {
     const RgbdImages im = ds.Load(i, settings.camera);
     const Timestamp t = ds.frame(i).rgb_stamp, td = ds.frame(i).depth_stamp;
@@ -193,6 +230,20 @@ TEST_F(IntegrationRosbagApi, CommandLineReadsTheBag) {
   EXPECT_NE(text.find("settings: camera info in"), std::string::npos) << text;
   const std::string all = "tracked " + std::to_string(kFrames) + "/" + std::to_string(kFrames) + " frames";
   EXPECT_NE(text.find(all), std::string::npos) << text;
+  // Ground truth from the bag's tf: the folder's groundtruth.txt again.
+  const std::string gt = (fs::path(out) / "gt_from_tf.txt").string();
+  ASSERT_EQ(testing::RunCli("rosbag groundtruth " + bag + " --out " + gt, log), 0)
+      << testing::ReadFileBytes(log);
+  const Trajectory from_tf = ReadTumTrajectory(gt);
+  const Trajectory truth = ReadTumTrajectory((fs::path(dir_) / "groundtruth.txt").string());
+  ASSERT_EQ(from_tf.size(), truth.size());
+  for (size_t i = 0; i < truth.size(); ++i) {
+    EXPECT_EQ(from_tf[i].stamp, truth[i].stamp);
+    EXPECT_LT((from_tf[i].world_from_cam.translation() - truth[i].world_from_cam.translation()).norm(), 1e-8);
+    EXPECT_LT(from_tf[i].world_from_cam.rotation().angularDistance(truth[i].world_from_cam.rotation()), 1e-8);
+  }
+  ASSERT_EQ(testing::RunCli("rosbag info " + bag, log), 0);
+  EXPECT_NE(testing::ReadFileBytes(log).find("/tf_static"), std::string::npos) << testing::ReadFileBytes(log);
   // Errors name the problem and exit non-zero.
   EXPECT_NE(testing::RunCli("run --rosbag " + bag + " --rgb-topic /camera/rgb/image --out " + out,
                             log),

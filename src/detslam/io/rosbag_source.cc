@@ -234,6 +234,13 @@ RosbagSource RosbagSource::Open(const std::string& path, const RosbagOptions& op
   return source;
 }
 
+bool RosbagSource::has_tf() const {
+  return std::any_of(bag_->connections().begin(), bag_->connections().end(),
+                     [](const RosbagConnection& c) {
+                       return c.type == "tf2_msgs/TFMessage" || c.type == "tf/tfMessage";
+                     });
+}
+
 Timestamp RosbagSource::stamp(size_t i) const {
   DETSLAM_CHECK_MSG(i < frames_.size(), "frame " << i << " of " << frames_.size());
   return frames_[i].rgb_stamp;

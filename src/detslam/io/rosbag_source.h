@@ -46,6 +46,8 @@ class RosbagSource : public RgbdSource {
   // The first message on the camera-info topic, if the bag has one.
   const std::optional<RosCameraInfo>& camera_info() const { return camera_info_; }
   const RosbagOptions& options() const { return options_; }
+  // Whether the bag has tf topics (`detslam rosbag groundtruth` may then export ground truth).
+  bool has_tf() const;
   size_t rgb_messages() const { return rgb_count_; }
   size_t depth_messages() const { return depth_count_; }
 
