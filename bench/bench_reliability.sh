@@ -113,6 +113,7 @@ what = {
     "vocabulary": "vocabulary files (raw, or with a valid checksum), then words of descriptors",
     "map_file": "map files (raw, or with a valid checksum), loaded with their own header's camera",
     "settings": "settings YAML (both key styles) and --set values, resolved against every key",
+    "rosbag": "ROS 1 bags (RosbagFile, RosbagSource: chunks, records, Image/CameraInfo/TFMessage)",
 }
 for line in open(sys.argv[1]):
     m = re.match(r"\[fuzz\] (\w+): (\S+) inputs in (\S+) s, no crash", line)

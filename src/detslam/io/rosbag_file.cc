@@ -319,7 +319,7 @@ RosbagFile RosbagFile::Open(const std::string& path, const MessageVisitor& visit
     }
   }
   if (!bag.truncation_.empty()) spdlog::warn("{}: {}", path, bag.truncation_);
-  spdlog::info("{}: {} messages on {} connections in {} chunks{}", path, bag.messages_.size(),
+  spdlog::debug("{}: {} messages on {} connections in {} chunks{}", path, bag.messages_.size(),
                bag.connections_.size(), bag.chunks_.size(), bag.indexed_ ? "" : " (unindexed)");
   return bag;
 }
