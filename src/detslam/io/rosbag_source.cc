@@ -94,66 +94,6 @@ void CheckLayout(const RosImage& im, int bytes_per_pixel, const std::string& whe
   }
 }
 
-cv::Mat DecodeColour(const RosImage& im, const std::string& where) {
-  cv::Mat bgr;
-  const std::string& e = im.encoding;
-  if (e == "rgb8" || e == "bgr8") {
-    CheckLayout(im, 3, where);
-    if (e == "rgb8") {
-      cv::cvtColor(View(im, CV_8UC3), bgr, cv::COLOR_RGB2BGR);
-    } else {
-      bgr = View(im, CV_8UC3).clone();
-    }
-  } else if (e == "rgba8" || e == "bgra8") {
-    CheckLayout(im, 4, where);
-    cv::cvtColor(View(im, CV_8UC4), bgr, e == "rgba8" ? cv::COLOR_RGBA2BGR : cv::COLOR_BGRA2BGR);
-  } else if (e == "mono8" || e == "8UC1") {
-    CheckLayout(im, 1, where);
-    cv::cvtColor(View(im, CV_8UC1), bgr, cv::COLOR_GRAY2BGR);
-  } else {
-    throw std::runtime_error(where + "colour encoding '" + e +
-                             "' is not supported (rgb8, bgr8, rgba8, bgra8, mono8)");
-  }
-  return bgr;
-}
-
-cv::Mat DecodeDepth(const RosImage& im, const std::string& where) {
-  cv::Mat metres;
-  const bool swap = im.big_endian;
-  if (im.encoding == "32FC1") {
-    CheckLayout(im, 4, where);
-    metres.create(static_cast<int>(im.height), static_cast<int>(im.width), CV_32FC1);
-    for (uint32_t y = 0; y < im.height; ++y) {
-      const uint8_t* row = im.data + static_cast<size_t>(y) * im.step;
-      float* out = metres.ptr<float>(static_cast<int>(y));
-      for (uint32_t x = 0; x < im.width; ++x) {
-        uint8_t b[4];
-        std::memcpy(b, row + 4 * x, 4);
-        if (swap) std::reverse(b, b + 4);
-        float v;
-        std::memcpy(&v, b, 4);
-        out[x] = std::isfinite(v) && v > 0 ? v : 0.0f;
-      }
-    }
-  } else if (im.encoding == "16UC1" || im.encoding == "mono16") {
-    CheckLayout(im, 2, where);
-    metres.create(static_cast<int>(im.height), static_cast<int>(im.width), CV_32FC1);
-    for (uint32_t y = 0; y < im.height; ++y) {
-      const uint8_t* row = im.data + static_cast<size_t>(y) * im.step;
-      float* out = metres.ptr<float>(static_cast<int>(y));
-      for (uint32_t x = 0; x < im.width; ++x) {
-        const uint16_t v = swap ? static_cast<uint16_t>(row[2 * x] << 8 | row[2 * x + 1])
-                                : static_cast<uint16_t>(row[2 * x + 1] << 8 | row[2 * x]);
-        out[x] = static_cast<float>(v) * 0.001f;
-      }
-    }
-  } else {
-    throw std::runtime_error(where + "depth encoding '" + im.encoding +
-                             "' is not supported (32FC1 metres, 16UC1 millimetres)");
-  }
-  return metres;
-}
-
 }  // namespace
 
 bool RosbagOptions::Check(std::string* error) const {
@@ -259,9 +199,9 @@ RgbdImages RosbagSource::Load(size_t i, const PinholeCamera& camera) const {
   const std::string depth_where = Where(options_.depth_topic, f.depth_stamp);
   try {
     const std::vector<uint8_t> rgb_bytes = bag_->Read(bag_->messages()[f.rgb]);
-    out.bgr = DecodeColour(ParseRosImage(rgb_bytes.data(), rgb_bytes.size()), rgb_where);
+    out.bgr = RosImageToBgr(ParseRosImage(rgb_bytes.data(), rgb_bytes.size()), rgb_where);
     const std::vector<uint8_t> depth_bytes = bag_->Read(bag_->messages()[f.depth]);
-    out.depth_m = DecodeDepth(ParseRosImage(depth_bytes.data(), depth_bytes.size()), depth_where);
+    out.depth_m = RosImageToDepthMetres(ParseRosImage(depth_bytes.data(), depth_bytes.size()), depth_where);
   } catch (const InputError&) {
     throw;
   } catch (const std::exception& e) {
@@ -281,6 +221,98 @@ RgbdImages RosbagSource::Load(size_t i, const PinholeCamera& camera) const {
   return out;
 }
 
+cv::Mat RosImageToBgr(const RosImage& im, const std::string& where) {
+  cv::Mat bgr;
+  const std::string& e = im.encoding;
+  if (e == "rgb8" || e == "bgr8") {
+    CheckLayout(im, 3, where);
+    if (e == "rgb8") {
+      cv::cvtColor(View(im, CV_8UC3), bgr, cv::COLOR_RGB2BGR);
+    } else {
+      bgr = View(im, CV_8UC3).clone();
+    }
+  } else if (e == "rgba8" || e == "bgra8") {
+    CheckLayout(im, 4, where);
+    cv::cvtColor(View(im, CV_8UC4), bgr, e == "rgba8" ? cv::COLOR_RGBA2BGR : cv::COLOR_BGRA2BGR);
+  } else if (e == "mono8" || e == "8UC1") {
+    CheckLayout(im, 1, where);
+    cv::cvtColor(View(im, CV_8UC1), bgr, cv::COLOR_GRAY2BGR);
+  } else {
+    throw std::runtime_error(where + "colour encoding '" + e +
+                             "' is not supported (rgb8, bgr8, rgba8, bgra8, mono8)");
+  }
+  return bgr;
+}
+
+cv::Mat RosImageToDepthMetres(const RosImage& im, const std::string& where) {
+  cv::Mat metres;
+  const bool swap = im.big_endian;
+  if (im.encoding == "32FC1") {
+    CheckLayout(im, 4, where);
+    metres.create(static_cast<int>(im.height), static_cast<int>(im.width), CV_32FC1);
+    for (uint32_t y = 0; y < im.height; ++y) {
+      const uint8_t* row = im.data + static_cast<size_t>(y) * im.step;
+      float* out = metres.ptr<float>(static_cast<int>(y));
+      for (uint32_t x = 0; x < im.width; ++x) {
+        uint8_t b[4];
+        std::memcpy(b, row + 4 * x, 4);
+        if (swap) std::reverse(b, b + 4);
+        float v;
+        std::memcpy(&v, b, 4);
+        out[x] = std::isfinite(v) && v > 0 ? v : 0.0f;
+      }
+    }
+  } else if (im.encoding == "16UC1" || im.encoding == "mono16") {
+    CheckLayout(im, 2, where);
+    metres.create(static_cast<int>(im.height), static_cast<int>(im.width), CV_32FC1);
+    for (uint32_t y = 0; y < im.height; ++y) {
+      const uint8_t* row = im.data + static_cast<size_t>(y) * im.step;
+      float* out = metres.ptr<float>(static_cast<int>(y));
+      for (uint32_t x = 0; x < im.width; ++x) {
+        const uint16_t v = swap ? static_cast<uint16_t>(row[2 * x] << 8 | row[2 * x + 1])
+                                : static_cast<uint16_t>(row[2 * x + 1] << 8 | row[2 * x]);
+        out[x] = static_cast<float>(v) * 0.001f;
+      }
+    }
+  } else {
+    throw std::runtime_error(where + "depth encoding '" + im.encoding +
+                             "' is not supported (32FC1 metres, 16UC1 millimetres)");
+  }
+  return metres;
+}
+
+Settings SettingsFromCameraInfo(const RosCameraInfo& info, const std::string& source) {
+  Settings s = PresetByName("fr3");
+  s.source = "camera info in " + source;
+  s.camera.width = static_cast<int>(info.width);
+  s.camera.height = static_cast<int>(info.height);
+  s.camera.fx = info.k[0];
+  s.camera.cx = info.k[2];
+  s.camera.fy = info.k[4];
+  s.camera.cy = info.k[5];
+  const std::vector<double>& d = info.d;
+  if (info.distortion_model == "plumb_bob" && d.size() == 5) {
+    s.camera.k1 = d[0];
+    s.camera.k2 = d[1];
+    s.camera.p1 = d[2];
+    s.camera.p2 = d[3];
+    s.camera.k3 = d[4];
+  } else if (std::any_of(d.begin(), d.end(), [](double v) { return v != 0; })) {
+    throw InputError(source, 0,
+                     "camera info has distortion model '" + info.distortion_model + "' with " +
+                         std::to_string(d.size()) +
+                         " coefficients (only plumb_bob with 5 is read); pass --config FILE");
+  }
+  std::string error;
+  if (!s.camera.Check(&error)) {
+    throw InputError(source, 0, "camera info gives an invalid camera: " + error);
+  }
+  spdlog::info("{}: camera from its camera info: {}x{}, fx {} fy {} cx {} cy {}", source,
+               s.camera.width, s.camera.height, s.camera.fx, s.camera.fy, s.camera.cx,
+               s.camera.cy);
+  return s;
+}
+
 Settings SettingsForBag(const std::string& bag_path, const std::optional<RosCameraInfo>& info) {
   try {
     return PresetForDataset(bag_path);
@@ -291,35 +323,7 @@ Settings SettingsForBag(const std::string& bag_path, const std::optional<RosCame
                        "info; pass the settings with --config FILE");
     }
   }
-  Settings s = PresetByName("fr3");
-  s.source = "camera info in " + bag_path;
-  s.camera.width = static_cast<int>(info->width);
-  s.camera.height = static_cast<int>(info->height);
-  s.camera.fx = info->k[0];
-  s.camera.cx = info->k[2];
-  s.camera.fy = info->k[4];
-  s.camera.cy = info->k[5];
-  const std::vector<double>& d = info->d;
-  if (info->distortion_model == "plumb_bob" && d.size() == 5) {
-    s.camera.k1 = d[0];
-    s.camera.k2 = d[1];
-    s.camera.p1 = d[2];
-    s.camera.p2 = d[3];
-    s.camera.k3 = d[4];
-  } else if (std::any_of(d.begin(), d.end(), [](double v) { return v != 0; })) {
-    throw InputError(bag_path, 0,
-                     "camera info has distortion model '" + info->distortion_model + "' with " +
-                         std::to_string(d.size()) +
-                         " coefficients (only plumb_bob with 5 is read); pass --config FILE");
-  }
-  std::string error;
-  if (!s.camera.Check(&error)) {
-    throw InputError(bag_path, 0, "camera info gives an invalid camera: " + error);
-  }
-  spdlog::info("{}: camera from its camera info: {}x{}, fx {} fy {} cx {} cy {}", bag_path,
-               s.camera.width, s.camera.height, s.camera.fx, s.camera.fy, s.camera.cx,
-               s.camera.cy);
-  return s;
+  return SettingsFromCameraInfo(*info, bag_path);
 }
 
 }  // namespace detslam

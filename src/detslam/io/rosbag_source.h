@@ -70,4 +70,16 @@ class RosbagSource : public RgbdSource {
 // distortion of `info`. Throws InputError when neither is available.
 Settings SettingsForBag(const std::string& bag_path, const std::optional<RosCameraInfo>& info);
 
+// The fr3 preset with the size, intrinsics and plumb_bob distortion of `info` (`source` names
+// where it came from, for messages and Settings::source). Throws InputError for another
+// distortion model with non-zero coefficients or an invalid camera.
+Settings SettingsFromCameraInfo(const RosCameraInfo& info, const std::string& source);
+
+// A colour image (rgb8, bgr8, rgba8, bgra8, mono8) as 8-bit BGR, and a depth image (32FC1 metres,
+// 16UC1 millimetres; either byte order) as CV_32FC1 metres with NaN, infinite and negative values
+// set to 0 (missing). Both copy the pixels. Throw std::runtime_error starting with `where` for
+// another encoding, a size of 0 or over 16384, or a row step shorter than a row.
+cv::Mat RosImageToBgr(const RosImage& image, const std::string& where = "");
+cv::Mat RosImageToDepthMetres(const RosImage& image, const std::string& where = "");
+
 }  // namespace detslam

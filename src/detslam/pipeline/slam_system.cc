@@ -277,6 +277,7 @@ KeyFrameId SlamSystem::TrackFrame(Frame frame, FrameReport* report) {
     tracked_.push_back(
         {frame.stamp, ref, *frame.cam_from_world * map.keyframe(ref).cam_from_world.Inverse()});
     report->map_id = map.MapOf(ref);
+    report->world_from_cam = frame.cam_from_world->Inverse();
   }
   report->keyframe = new_kf != kNoKeyFrame;
   report->map_keyframes = static_cast<int>(map.NumKeyFrames());

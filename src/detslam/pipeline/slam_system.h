@@ -80,6 +80,9 @@ struct FrameReport {
   TrackingResult tracking;
   bool keyframe = false;
   int map_id = -1;  // the map of the atlas the frame was tracked in (-1: no pose)
+  // With tracking.pose_valid: the frame's pose as tracked, in map map_id's frame (later loop
+  // corrections and merges move it; FrameTrajectories has the final poses).
+  Rigid3d world_from_cam;
   bool loop_closed = false;  // this frame's keyframe closed a loop (mapping in the tracking thread)
   KeyFrameId loop_keyframe = kNoKeyFrame;   // with loop_closed: the keyframe that closed it
   KeyFrameId loop_candidate = kNoKeyFrame;  //   the older keyframe of the same place
