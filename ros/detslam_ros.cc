@@ -78,7 +78,7 @@ RosCameraInfo ToInfo(const sensor_msgs::CameraInfo& m) {
 
 class Node {
  public:
-  Node(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) {
+  Node(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
     pnh.param<std::string>("config", config_, "");
     pnh.param<std::string>("segmenter", segmenter_spec_, "");
     pnh.param<std::string>("models", models_, "");
@@ -150,7 +150,9 @@ class Node {
       Start(SettingsFromCameraInfo(ToInfo(*m), "topic " + info_sub_.getTopic()));
     } catch (const std::exception& e) {
       ROS_ERROR_THROTTLE(5, "detslam_ros: cannot start from the camera info: %s", e.what());
+      return;
     }
+    Pair();  // the frames that came before it
   }
   void OnColour(const sensor_msgs::ImageConstPtr& m) {
     rgb_.push_back(m);
@@ -162,8 +164,16 @@ class Node {
   }
 
   // Pairs the oldest colour image with a depth image within max_dt (greedy, in stamp order);
-  // drops what can no longer be paired.
+  // drops what can no longer be paired. Until the camera is known (camera info), the newest
+  // kWaiting images of each stream wait.
   void Pair() {
+    if (!slam_) {
+      while (rgb_.size() > kWaiting) rgb_.pop_front();
+      while (depth_.size() > kWaiting) depth_.pop_front();
+      ROS_WARN_THROTTLE(5, "detslam_ros: waiting for camera info on %s (or set ~config)",
+                        info_sub_.getTopic().c_str());
+      return;
+    }
     while (!rgb_.empty() && !depth_.empty()) {
       const Timestamp c = ToStamp(rgb_.front()->header.stamp);
       size_t best = depth_.size();
@@ -183,18 +193,15 @@ class Node {
         continue;
       }
       // No partner yet: wait while a newer depth image could still come, else drop.
-      if (ToStamp(depth_.back()->header.stamp).Seconds() < c.Seconds() + max_dt_ && rgb_.size() < 10)
+      if (ToStamp(depth_.back()->header.stamp).Seconds() < c.Seconds() + max_dt_ &&
+          rgb_.size() < kWaiting)
         break;
       rgb_.pop_front();
     }
-    while (depth_.size() > 10) depth_.pop_front();
+    while (depth_.size() > kWaiting) depth_.pop_front();
   }
 
   void Process(const sensor_msgs::Image& rgb_msg, const sensor_msgs::Image& depth_msg) {
-    if (!slam_) {
-      ROS_WARN_THROTTLE(5, "detslam_ros: waiting for camera info (or set ~config); frame dropped");
-      return;
-    }
     const Timestamp stamp = ToStamp(rgb_msg.header.stamp);
     cv::Mat bgr, depth;
     try {
@@ -335,7 +342,7 @@ class Node {
     return true;
   }
 
-  ros::NodeHandle& nh_;
+  static constexpr size_t kWaiting = 10;  // images of a stream kept for pairing
   std::string config_, segmenter_spec_, models_, vocabulary_, out_dir_, world_frame_, camera_frame_;
   uint64_t seed_ = 42;
   double max_dt_ = 0.02;

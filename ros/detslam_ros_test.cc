@@ -30,6 +30,7 @@
 #include "detslam/pipeline/settings_keys.h"
 #include "detslam/segmentation/segmenter_factory.h"
 #include "detslam/synth/writer.h"
+#include "integration_util.h"
 #include "support/cli_runner.h"
 #include "support/ros_test_bag.h"
 
@@ -133,12 +134,7 @@ class IntegrationRosNode : public ::testing::Test {
       std::this_thread::sleep_for(100ms);
     }
 
-    seq_ = testing::TempDir("ros_node_seq");
-    SynthOptions so;
-    so.preset = "walking_xyz";
-    so.seed = 3;
-    so.frames = kFrames;
-    WriteSequence(so, seq_);
+    seq_ = integration::WritePresetSequence("ros_node_seq", "walking_xyz", 3, kFrames);
   }
   static void TearDownTestSuite() {
     ros::shutdown();

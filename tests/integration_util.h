@@ -24,6 +24,18 @@ inline std::string WriteStaticSequence(const std::string& name, uint64_t seed, i
   return dir;
 }
 
+// A synthetic sequence of `preset` in a fresh temporary folder named `name`; returns the folder.
+inline std::string WritePresetSequence(const std::string& name, const std::string& preset,
+                                       uint64_t seed, int frames) {
+  const std::string dir = testing::TempDir(name);
+  SynthOptions so;
+  so.preset = preset;
+  so.seed = seed;
+  so.frames = frames;
+  WriteSequence(so, dir);
+  return dir;
+}
+
 // The run.json of a run's output folder.
 inline nlohmann::json RunJson(const std::filesystem::path& out) {
   return nlohmann::json::parse(testing::ReadFileBytes(out / "run.json"));

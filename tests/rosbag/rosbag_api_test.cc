@@ -21,6 +21,7 @@
 #include "detslam/io/trajectory.h"
 #include "detslam/pipeline/runner.h"
 #include "detslam/synth/writer.h"
+#include "integration_util.h"
 #include "support/cli_runner.h"
 #include "support/ros_test_bag.h"
 
@@ -45,12 +46,7 @@ std::string Poses(const fs::path& out) {
 class IntegrationRosbagApi : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-    dir_ = testing::TempDir("rosbag_api_seq");
-    SynthOptions so;
-    so.preset = "walking_xyz";
-    so.seed = 3;
-    so.frames = kFrames;
-    WriteSequence(so, dir_);
+    dir_ = integration::WritePresetSequence("rosbag_api_seq", "walking_xyz", 3, kFrames);
     settings_ = ReadSettings((fs::path(dir_) / "settings.yaml").string());
     folder_out_ = testing::TempDir("rosbag_api_folder_out");
     RunOptions options;

@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cstdint>
 #include <cstring>
+#include <fstream>
 #include <opencv2/core.hpp>
 #include <stdexcept>
 #include <string>
@@ -18,6 +19,7 @@
 
 #include "detslam/core/timestamp.h"
 #include "detslam/io/rosbag_file.h"
+#include "support/cli_runner.h"
 
 namespace detslam::testing {
 
@@ -218,6 +220,14 @@ inline std::vector<uint8_t> CameraInfoMessage(Timestamp stamp, int width, int he
   for (double v : {fx, 0.0, cx, 0.0, 0.0, fy, cy, 0.0, 0.0, 0.0, 1.0, 0.0}) b.F64(v);  // P
   b.U32(0).U32(0).U32(0).U32(0).U32(0).U32(0).U8(0);
   return b.bytes();
+}
+
+// Writes `bytes` to the test's temporary file `name` (testing::TempPath); returns its path.
+inline std::string WriteBagFile(const std::vector<uint8_t>& bytes, const std::string& name) {
+  const std::string path = TempPath(name);
+  std::ofstream(path, std::ios::binary).write(reinterpret_cast<const char*>(bytes.data()),
+                                              static_cast<std::streamsize>(bytes.size()));
+  return path;
 }
 
 }  // namespace detslam::testing

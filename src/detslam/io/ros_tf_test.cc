@@ -107,15 +107,8 @@ std::vector<uint8_t> TfBag() {
   return bytes;
 }
 
-std::string WriteBag(const std::vector<uint8_t>& bytes, const std::string& name) {
-  const std::string path = testing::TempPath(name);
-  std::ofstream(path, std::ios::binary).write(reinterpret_cast<const char*>(bytes.data()),
-                                              static_cast<std::streamsize>(bytes.size()));
-  return path;
-}
-
 TEST(GroundTruthFromBag, TumStyleTree) {
-  const std::string path = WriteBag(TfBag(), "tf.bag");
+  const std::string path = testing::WriteBagFile(TfBag(), "tf.bag");
   TfGroundTruthOptions o;
   o.child = "/openni_rgb_optical_frame";
   const TfGroundTruth gt = GroundTruthFromBag(path, o);

@@ -43,13 +43,6 @@ cv::Mat DepthMetres(int i) {
   return m;
 }
 
-std::string WriteBag(const std::vector<uint8_t>& bytes, const std::string& name) {
-  const std::string path = testing::TempPath(name);
-  std::ofstream(path, std::ios::binary).write(reinterpret_cast<const char*>(bytes.data()),
-                                              static_cast<std::streamsize>(bytes.size()));
-  return path;
-}
-
 // A bag of `frames` colour (rgb8) and 32FC1 depth frames at 30 Hz, depth 5 ms after colour.
 std::vector<uint8_t> MakeBag(RosbagCompression c, int frames, bool index = true,
                              size_t chunk_bytes = 1 << 20) {
@@ -87,7 +80,7 @@ class RosbagCompressionTest : public ::testing::TestWithParam<RosbagCompression>
 
 TEST_P(RosbagCompressionTest, ReadsFramesStampsAndCameraInfo) {
   // Small chunks: frames spread over many chunks, so Load reads across them.
-  const std::string path = WriteBag(MakeBag(GetParam(), 12, true, 600), "bag_ok.bag");
+  const std::string path = testing::WriteBagFile(MakeBag(GetParam(), 12, true, 600), "bag_ok.bag");
   const RosbagSource s = RosbagSource::Open(path, RosbagOptions());
   ASSERT_EQ(s.size(), 12u);
   EXPECT_EQ(s.rgb_messages(), 12u);
@@ -115,7 +108,7 @@ INSTANTIATE_TEST_SUITE_P(All, RosbagCompressionTest,
                                            RosbagCompression::kLz4));
 
 TEST(RosbagSource, PresetFromTheFileNameWinsOverCameraInfo) {
-  const std::string path = WriteBag(MakeBag(RosbagCompression::kNone, 2),
+  const std::string path = testing::WriteBagFile(MakeBag(RosbagCompression::kNone, 2),
                                     "rgbd_dataset_freiburg1_xyz.bag");
   const RosbagSource s = RosbagSource::Open(path, RosbagOptions());
   EXPECT_EQ(SettingsForBag(path, s.camera_info()).source, "preset fr1");
@@ -138,7 +131,7 @@ TEST(RosbagSource, DepthEncodingsStepPaddingAndByteOrder) {
   w.Write(depth, Stamp(1), testing::ImageMessage(Stamp(1), mm, "16UC1", 0, true));
   w.Write(rgb, Stamp(2), testing::ImageMessage(Stamp(2), gray, "mono8"));
   w.Write(depth, Stamp(2), testing::ImageMessage(Stamp(2), nan_depth, "32FC1", kWidth * 4 + 4));
-  const std::string path = WriteBag(w.Finish(), "bag_encodings.bag");
+  const std::string path = testing::WriteBagFile(w.Finish(), "bag_encodings.bag");
   const RosbagSource s = RosbagSource::Open(path, RosbagOptions());
   ASSERT_EQ(s.size(), 2u);
   const RgbdImages a = s.Load(0, Camera());
@@ -163,7 +156,7 @@ TEST(RosbagSource, UnsortedMessagesAreOrderedByHeaderStamp) {
     w.Write(rgb, Stamp(50), testing::ImageMessage(Stamp(1 + i), rgb8, "rgb8"));
     w.Write(depth, Stamp(50), testing::ImageMessage(Stamp(1 + i), DepthMetres(i), "32FC1"));
   }
-  const RosbagSource s = RosbagSource::Open(WriteBag(w.Finish(), "bag_unsorted.bag"), {});
+  const RosbagSource s = RosbagSource::Open(testing::WriteBagFile(w.Finish(), "bag_unsorted.bag"), {});
   ASSERT_EQ(s.size(), 3u);
   for (int i = 0; i < 3; ++i) {
     EXPECT_EQ(s.stamp(i), Stamp(1 + i));
@@ -180,7 +173,7 @@ TEST(RosbagSource, ClearErrors) {
     }
     return std::string("no error");
   };
-  const std::string ok = WriteBag(MakeBag(RosbagCompression::kNone, 3), "bag_errors.bag");
+  const std::string ok = testing::WriteBagFile(MakeBag(RosbagCompression::kNone, 3), "bag_errors.bag");
   RosbagOptions other;
   other.rgb_topic = "/nope";
   EXPECT_THAT(open_error(ok, other), HasSubstr("no topic /nope"));
@@ -204,7 +197,7 @@ TEST(RosbagSource, ClearErrors) {
   const uint32_t depth = w.AddConnection(kDepth, "sensor_msgs/Image");
   w.Write(rgb, Stamp(1), testing::ImageMessage(Stamp(1), Colour(0), "yuv422"));
   w.Write(depth, Stamp(1), testing::ImageMessage(Stamp(1), DepthMetres(0), "32FC1"));
-  const RosbagSource s = RosbagSource::Open(WriteBag(w.Finish(), "bag_yuv.bag"), {});
+  const RosbagSource s = RosbagSource::Open(testing::WriteBagFile(w.Finish(), "bag_yuv.bag"), {});
   try {
     s.Load(0, Camera());
     ADD_FAILURE() << "no error";
@@ -220,14 +213,14 @@ TEST(RosbagSource, ClearErrors) {
 
 TEST(RosbagFile, CutOffRecordingReadsTheCompleteChunks) {
   const std::vector<uint8_t> full = MakeBag(RosbagCompression::kLz4, 20, false, 400);
-  const RosbagFile whole = RosbagFile::Open(WriteBag(full, "bag_whole.bag"));
+  const RosbagFile whole = RosbagFile::Open(testing::WriteBagFile(full, "bag_whole.bag"));
   EXPECT_FALSE(whole.indexed());
   EXPECT_TRUE(whole.truncation().empty());
   ASSERT_GT(whole.chunks().size(), 4u);
   // Cut inside the fourth chunk's data: the three before it stay readable.
   const size_t cut = whole.chunks()[3].data_pos + whole.chunks()[3].data_size / 2;
   const std::vector<uint8_t> head(full.begin(), full.begin() + static_cast<long>(cut));
-  const std::string path = WriteBag(head, "bag_cut.bag");
+  const std::string path = testing::WriteBagFile(head, "bag_cut.bag");
   const RosbagFile bag = RosbagFile::Open(path);
   EXPECT_EQ(bag.chunks().size(), 3u);
   EXPECT_THAT(bag.truncation(), HasSubstr("recording cut off"));
@@ -239,7 +232,7 @@ TEST(RosbagFile, CutOffRecordingReadsTheCompleteChunks) {
   const spdlog::level::level_enum level = spdlog::get_level();
   spdlog::set_level(spdlog::level::err);
   for (size_t n = 0; n < full.size(); n += 97) {
-    const std::string p = WriteBag(std::vector<uint8_t>(full.begin(), full.begin() + static_cast<long>(n)),
+    const std::string p = testing::WriteBagFile(std::vector<uint8_t>(full.begin(), full.begin() + static_cast<long>(n)),
                                    "bag_cut_n.bag");
     try {
       RosbagFile::Open(p);
@@ -251,12 +244,12 @@ TEST(RosbagFile, CutOffRecordingReadsTheCompleteChunks) {
 
 TEST(RosbagFile, CorruptChunksAndRecordsAreInputErrors) {
   const std::vector<uint8_t> good = MakeBag(RosbagCompression::kBz2, 3);
-  const RosbagFile bag = RosbagFile::Open(WriteBag(good, "bag_bz2.bag"));
+  const RosbagFile bag = RosbagFile::Open(testing::WriteBagFile(good, "bag_bz2.bag"));
   ASSERT_EQ(bag.chunks().size(), 1u);
   std::vector<uint8_t> bad = good;
   bad[bag.chunks()[0].data_pos + bag.chunks()[0].data_size / 2] ^= 0x5a;
   try {
-    RosbagFile::Open(WriteBag(bad, "bag_bz2_bad.bag"));
+    RosbagFile::Open(testing::WriteBagFile(bad, "bag_bz2_bad.bag"));
     ADD_FAILURE() << "no error";
   } catch (const InputError& e) {
     EXPECT_THAT(e.what(), HasSubstr("bz2 chunk"));
@@ -272,7 +265,7 @@ TEST(RosbagFile, CorruptChunksAndRecordsAreInputErrors) {
   ASSERT_NE(at, std::string::npos);
   text.replace(at, 15, "compression=zzz");
   try {
-    RosbagFile::Open(WriteBag(std::vector<uint8_t>(text.begin(), text.end()), "bag_zzz.bag"));
+    RosbagFile::Open(testing::WriteBagFile(std::vector<uint8_t>(text.begin(), text.end()), "bag_zzz.bag"));
     ADD_FAILURE() << "no error";
   } catch (const InputError& e) {
     EXPECT_THAT(e.what(), HasSubstr("unknown chunk compression 'zzz'"));
