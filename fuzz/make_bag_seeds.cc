@@ -1,6 +1,8 @@
 // Writes the seed bags of fuzz/corpus/rosbag (fuzz/make_corpus.sh runs it): two 4x3 frames with
-// camera info, one bag per chunk compression, and a cut-off unindexed one.
+// camera info, one bag per chunk compression, a cut-off unindexed one, and one with compressed
+// image topics.
 #include <fstream>
+#include <opencv2/imgcodecs.hpp>
 #include <string>
 
 #include "support/bag_writer.h"
@@ -35,5 +37,21 @@ int main(int argc, char** argv) {
     std::ofstream(dir + "/" + name + (cut ? "_cut" : "") + ".bag", std::ios::binary)
         .write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
   }
+  // Compressed topics: PNG colour, compressedDepth (16UC1 PNG behind its 12-byte header).
+  testing::BagWriter w;
+  const uint32_t rgb = w.AddConnection("/camera/rgb/image_color", "sensor_msgs/CompressedImage");
+  const uint32_t depth = w.AddConnection("/camera/depth/image", "sensor_msgs/CompressedImage");
+  std::vector<uint8_t> png, depth_png;
+  cv::imencode(".png", cv::Mat(3, 4, CV_8UC3, cv::Scalar(1, 2, 3)), png);
+  cv::imencode(".png", cv::Mat(3, 4, CV_16UC1, cv::Scalar(1500)), depth_png);
+  testing::Bytes compressed_depth;
+  compressed_depth.U32(0).U32(0).U32(0).Raw(depth_png);
+  w.Write(rgb, Timestamp{1000000000}, testing::CompressedImageMessage(Timestamp{1000000000}, "png", png));
+  w.Write(depth, Timestamp{1000000000},
+          testing::CompressedImageMessage(Timestamp{1000000000}, "16UC1; compressedDepth png",
+                                          compressed_depth.bytes()));
+  const std::vector<uint8_t> bytes = w.Finish();
+  std::ofstream(dir + "/compressed.bag", std::ios::binary)
+      .write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
   return 0;
 }

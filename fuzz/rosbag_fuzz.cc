@@ -1,6 +1,8 @@
 // Fuzz target: ROS 1 bag files (RosbagFile::Open, the sensor_msgs parsers, RosbagSource::Open and
 // Load). Every message's bytes also go through each message parser, whatever its topic, so the
-// fuzzer reaches Image, CameraInfo and TFMessage parsing from any connection.
+// fuzzer reaches Image, CompressedImage, CameraInfo and
+// TFMessage parsing from any connection; Load decodes the compressed images of the default topics.
+#include <cstdlib>
 #include <stdexcept>
 
 #include "detslam/io/ros_messages.h"
@@ -22,12 +24,20 @@ void Parses(F&& f) {
 
 }  // namespace
 
+// Compressed images that claim a huge size are refused by OpenCV (read once, at its first decode)
+// instead of allocating gigabytes.
+extern "C" int LLVMFuzzerInitialize(int*, char***) {
+  setenv("OPENCV_IO_MAX_IMAGE_PIXELS", "4194304", 1);
+  return 0;
+}
+
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   using namespace detslam;
   const std::string path = fuzz::WriteInput("input.bag", fuzz::Bytes(data, size));
   fuzz::Accepts([&] {
     RosbagFile::Open(path, [](const RosbagMessage& m, const RosbagConnection&, const uint8_t* b) {
       Parses([&] { ParseRosImage(b, m.size); });
+      Parses([&] { ParseRosCompressedImage(b, m.size); });
       Parses([&] { ParseRosCameraInfo(b, m.size); });
       Parses([&] { ParseRosTfMessage(b, m.size); });
     });

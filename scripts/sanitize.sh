@@ -36,7 +36,7 @@ if [ -n "${UNITY:-}" ]; then EXTRA+=(-DCMAKE_UNITY_BUILD=ON); fi
 # took 10-20 times longer); -g1 keeps the reports' stacks readable.
 cmake -S "$ROOT" -B "$BUILD_DIR" "${GEN[@]}" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
   -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O2 -g1" -DDETSLAM_SANITIZE="$flags" \
-  -DDETSLAM_BUILD_BENCH=OFF "${EXTRA[@]}" >/dev/null
+  -DDETSLAM_BUILD_BENCH=OFF -DDETSLAM_ROS=OFF "${EXTRA[@]}" >/dev/null
 start=$(date +%s)
 if [ -n "${TARGETS:-}" ]; then
   # shellcheck disable=SC2086

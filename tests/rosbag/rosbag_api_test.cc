@@ -84,14 +84,18 @@ TEST_F(IntegrationRosbagApi, MetresDepthGivesTheFolderTrajectoryWithEveryCompres
     const RosbagSource source = RosbagSource::Open(bag, {});
     ASSERT_EQ(source.size(), static_cast<size_t>(kFrames));
     const RgbdDataset folder_ds = RgbdDataset::Open(dir_, {});
-    for (size_t i : {size_t{0}, size_t{kFrames / 2}, size_t{kFrames - 1}}) {
+    // Every frame decodes to the folder's images bit for bit, so a deterministic run gives the
+    // folder's trajectory: run on one of them (bz2; the command-line test runs an lz4 bag).
+    for (size_t i = 0; i < source.size(); ++i) {
       EXPECT_EQ(source.stamp(i), folder_ds.frame(i).rgb_stamp);
       const RgbdImages a = source.Load(i, settings_.camera);
       const RgbdImages b = folder_ds.Load(i, settings_.camera);
-      EXPECT_EQ(cv::norm(a.bgr, b.bgr, cv::NORM_INF), 0);
-      EXPECT_EQ(cv::norm(a.depth_m, b.depth_m, cv::NORM_INF), 0);
+      EXPECT_EQ(cv::norm(a.bgr, b.bgr, cv::NORM_INF), 0) << "frame " << i;
+      EXPECT_EQ(cv::norm(a.depth_m, b.depth_m, cv::NORM_INF), 0) << "frame " << i;
     }
-    EXPECT_EQ(Poses(RunBag(bag, std::string("rosbag_api_out_") + name)), folder);
+    if (compression == rosbag::compression::BZ2) {
+      EXPECT_EQ(Poses(RunBag(bag, std::string("rosbag_api_out_") + name)), folder);
+    }
   }
 }
 

@@ -206,6 +206,15 @@ inline std::vector<uint8_t> ImageMessage(Timestamp stamp, const cv::Mat& m, cons
   return b.bytes();
 }
 
+// sensor_msgs/CompressedImage with `format` and the encoded `data`.
+inline std::vector<uint8_t> CompressedImageMessage(Timestamp stamp, const std::string& format,
+                                                   const std::vector<uint8_t>& data) {
+  Bytes b;
+  b.U32(0).Time(stamp).String("camera").String(format);
+  b.U32(static_cast<uint32_t>(data.size())).Raw(data);
+  return b.bytes();
+}
+
 // sensor_msgs/CameraInfo (plumb_bob) of a width x height camera.
 inline std::vector<uint8_t> CameraInfoMessage(Timestamp stamp, int width, int height, double fx,
                                               double fy, double cx, double cy,

@@ -85,6 +85,16 @@ RosImage ParseRosImage(const uint8_t* bytes, size_t size) {
   return im;
 }
 
+RosCompressedImage ParseRosCompressedImage(const uint8_t* bytes, size_t size) {
+  WireReader r(bytes, size, "sensor_msgs/CompressedImage");
+  RosCompressedImage im;
+  im.header = r.Header();
+  im.format = r.String("format");
+  im.data = r.Bytes("data", &im.data_size);
+  r.End();
+  return im;
+}
+
 RosCameraInfo ParseRosCameraInfo(const uint8_t* bytes, size_t size) {
   WireReader r(bytes, size, "sensor_msgs/CameraInfo");
   RosCameraInfo c;

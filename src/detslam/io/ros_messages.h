@@ -1,6 +1,6 @@
 // The ROS 1 messages detslam reads from bags, deserialized from their wire format (little-endian,
 // strings and variable arrays prefixed by a uint32 length): sensor_msgs/Image,
-// sensor_msgs/CameraInfo and tf2_msgs/TFMessage (= tf/tfMessage).
+// sensor_msgs/CompressedImage, sensor_msgs/CameraInfo and tf2_msgs/TFMessage (= tf/tfMessage).
 #pragma once
 
 #include <array>
@@ -28,6 +28,16 @@ struct RosImage {
   size_t data_size = 0;
 };
 
+// sensor_msgs/CompressedImage: `format` is "jpeg" / "png" (image_transport's compressed plugin
+// writes e.g. "rgb8; jpeg compressed bgr8") or, for depth, "16UC1; compressedDepth png" /
+// "32FC1; compressedDepth png" (compressedDepth: a 12-byte header before the PNG).
+struct RosCompressedImage {
+  RosHeader header;
+  std::string format;
+  const uint8_t* data = nullptr;  // inside the parsed buffer
+  size_t data_size = 0;
+};
+
 struct RosCameraInfo {
   RosHeader header;
   uint32_t height = 0, width = 0;
@@ -47,6 +57,7 @@ struct RosTransform {
 // impossible, or bytes are left over. ParseRosImage also checks that data holds height * step
 // bytes; the returned image points into `bytes`.
 RosImage ParseRosImage(const uint8_t* bytes, size_t size);
+RosCompressedImage ParseRosCompressedImage(const uint8_t* bytes, size_t size);
 RosCameraInfo ParseRosCameraInfo(const uint8_t* bytes, size_t size);
 std::vector<RosTransform> ParseRosTfMessage(const uint8_t* bytes, size_t size);
 // The header stamp of any message that starts with a std_msgs/Header.

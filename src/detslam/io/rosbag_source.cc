@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <sstream>
 
@@ -35,17 +36,22 @@ std::vector<Stamped> SortedUnique(std::vector<Stamped> v, const std::string& bag
   return v;
 }
 
+bool IsImageType(const std::string& type) {
+  return type == "sensor_msgs/Image" || type == "sensor_msgs/CompressedImage";
+}
+
 std::string ImageTopics(const RosbagFile& bag) {
   std::string s;
   for (const RosbagConnection& c : bag.connections()) {
-    if (c.type != "sensor_msgs/Image" && c.type != "sensor_msgs/CompressedImage") continue;
+    if (!IsImageType(c.type)) continue;
     if (s.find(c.topic + " ") != std::string::npos) continue;
     s += (s.empty() ? "" : ", ") + c.topic + " (" + c.type + ")";
   }
   return s.empty() ? "none" : s;
 }
 
-// Checks that `topic` exists with `type`; returns false for an optional topic that is absent.
+// Checks that `topic` exists and carries `type` (for "image": sensor_msgs/Image or
+// CompressedImage); returns false for an optional topic that is absent.
 bool CheckTopic(const RosbagFile& bag, const std::string& topic, const std::string& type,
                 const std::string& role, bool required) {
   const std::vector<uint32_t> ids = bag.ConnectionsOn(topic);
@@ -58,18 +64,24 @@ bool CheckTopic(const RosbagFile& bag, const std::string& topic, const std::stri
   }
   for (uint32_t id : ids) {
     const RosbagConnection* c = bag.connection(id);
-    if (c->type != type) {
-      std::string hint;
-      if (c->type == "sensor_msgs/CompressedImage") {
-        hint = " (compressed image topics are not read yet: record the raw topic, or decompress "
-               "with `rosrun image_transport republish compressed in:=T raw out:=T`)";
-      }
+    const bool ok = type == "image" ? IsImageType(c->type) : c->type == type;
+    if (!ok) {
       throw InputError(bag.path(), 0,
                        "topic " + topic + " (the " + role + " topic) carries " + c->type +
-                           ", expected " + type + hint);
+                           ", expected " +
+                           (type == "image" ? "sensor_msgs/Image or CompressedImage" : type));
     }
   }
   return true;
+}
+
+// cv::imdecode, its exceptions (e.g. an image over OPENCV_IO_MAX_IMAGE_PIXELS) as runtime_error.
+cv::Mat Decode(const cv::Mat& buffer, const std::string& where) {
+  try {
+    return cv::imdecode(buffer, cv::IMREAD_UNCHANGED);
+  } catch (const cv::Exception& e) {
+    throw std::runtime_error(where + "compressed image does not decode: " + e.what());
+  }
 }
 
 std::string Where(const std::string& topic, Timestamp stamp) {
@@ -121,9 +133,9 @@ RosbagSource RosbagSource::Open(const std::string& path, const RosbagOptions& op
     const size_t i = index++;
     if (!parse_error.empty()) return;
     try {
-      if (c.topic == options.rgb_topic && c.type == "sensor_msgs/Image") {
+      if (c.topic == options.rgb_topic && IsImageType(c.type)) {
         rgb.push_back({ParseRosHeaderStamp(data, m.size), i});
-      } else if (c.topic == options.depth_topic && c.type == "sensor_msgs/Image") {
+      } else if (c.topic == options.depth_topic && IsImageType(c.type)) {
         depth.push_back({ParseRosHeaderStamp(data, m.size), i});
       } else if (c.topic == options.camera_info_topic && c.type == "sensor_msgs/CameraInfo" &&
                  !source.camera_info_) {
@@ -137,8 +149,8 @@ RosbagSource RosbagSource::Open(const std::string& path, const RosbagOptions& op
   source.bag_ = std::make_shared<const RosbagFile>(RosbagFile::Open(path, visit));
   const RosbagFile& bag = *source.bag_;
   if (!parse_error.empty()) throw InputError(path, 0, parse_error);
-  CheckTopic(bag, options.rgb_topic, "sensor_msgs/Image", "colour", true);
-  CheckTopic(bag, options.depth_topic, "sensor_msgs/Image", "depth", true);
+  CheckTopic(bag, options.rgb_topic, "image", "colour", true);
+  CheckTopic(bag, options.depth_topic, "image", "depth", true);
   if (!options.camera_info_topic.empty() &&
       !CheckTopic(bag, options.camera_info_topic, "sensor_msgs/CameraInfo", "camera-info",
                   false)) {
@@ -181,6 +193,11 @@ bool RosbagSource::has_tf() const {
                      });
 }
 
+bool RosbagSource::Compressed(const RosbagMessage& m) const {
+  const RosbagConnection* c = bag_->connection(m.connection);
+  return c != nullptr && c->type == "sensor_msgs/CompressedImage";
+}
+
 Timestamp RosbagSource::stamp(size_t i) const {
   DETSLAM_CHECK_MSG(i < frames_.size(), "frame " << i << " of " << frames_.size());
   return frames_[i].rgb_stamp;
@@ -198,10 +215,18 @@ RgbdImages RosbagSource::Load(size_t i, const PinholeCamera& camera) const {
   const std::string rgb_where = Where(options_.rgb_topic, f.rgb_stamp);
   const std::string depth_where = Where(options_.depth_topic, f.depth_stamp);
   try {
-    const std::vector<uint8_t> rgb_bytes = bag_->Read(bag_->messages()[f.rgb]);
-    out.bgr = RosImageToBgr(ParseRosImage(rgb_bytes.data(), rgb_bytes.size()), rgb_where);
-    const std::vector<uint8_t> depth_bytes = bag_->Read(bag_->messages()[f.depth]);
-    out.depth_m = RosImageToDepthMetres(ParseRosImage(depth_bytes.data(), depth_bytes.size()), depth_where);
+    const RosbagMessage& rgb = bag_->messages()[f.rgb];
+    const std::vector<uint8_t> rgb_bytes = bag_->Read(rgb);
+    out.bgr = Compressed(rgb)
+                  ? RosCompressedToBgr(ParseRosCompressedImage(rgb_bytes.data(), rgb_bytes.size()), rgb_where)
+                  : RosImageToBgr(ParseRosImage(rgb_bytes.data(), rgb_bytes.size()), rgb_where);
+    const RosbagMessage& depth = bag_->messages()[f.depth];
+    const std::vector<uint8_t> depth_bytes = bag_->Read(depth);
+    out.depth_m =
+        Compressed(depth)
+            ? RosCompressedToDepthMetres(ParseRosCompressedImage(depth_bytes.data(), depth_bytes.size()),
+                                         depth_where)
+            : RosImageToDepthMetres(ParseRosImage(depth_bytes.data(), depth_bytes.size()), depth_where);
   } catch (const InputError&) {
     throw;
   } catch (const std::exception& e) {
@@ -277,6 +302,63 @@ cv::Mat RosImageToDepthMetres(const RosImage& im, const std::string& where) {
   } else {
     throw std::runtime_error(where + "depth encoding '" + im.encoding +
                              "' is not supported (32FC1 metres, 16UC1 millimetres)");
+  }
+  return metres;
+}
+
+cv::Mat RosCompressedToBgr(const RosCompressedImage& im, const std::string& where) {
+  if (im.data_size == 0) throw std::runtime_error(where + "empty compressed image");
+  const cv::Mat buffer(1, static_cast<int>(im.data_size), CV_8UC1, const_cast<uint8_t*>(im.data));
+  const cv::Mat decoded = Decode(buffer, where);
+  if (decoded.empty() || decoded.depth() != CV_8U) {
+    throw std::runtime_error(where + "compressed colour image (format '" + im.format +
+                             "') does not decode to an 8-bit image");
+  }
+  cv::Mat bgr;
+  switch (decoded.channels()) {
+    case 1:
+      cv::cvtColor(decoded, bgr, cv::COLOR_GRAY2BGR);
+      return bgr;
+    case 3:
+      return decoded;  // imdecode gives BGR for JPEG and PNG
+    case 4:
+      cv::cvtColor(decoded, bgr, cv::COLOR_BGRA2BGR);
+      return bgr;
+    default:
+      throw std::runtime_error(where + "compressed colour image with " +
+                               std::to_string(decoded.channels()) + " channels");
+  }
+}
+
+cv::Mat RosCompressedToDepthMetres(const RosCompressedImage& im, const std::string& where) {
+  const std::string& f = im.format;
+  if (f.find("compressedDepth") == std::string::npos) {
+    throw std::runtime_error(where + "compressed depth format '" + f +
+                             "' is not read (only image_transport's compressedDepth)");
+  }
+  constexpr size_t kHeader = 12;  // int32 format, float depthQuantA, float depthQuantB
+  if (im.data_size <= kHeader) throw std::runtime_error(where + "compressedDepth data too short");
+  float quant[2];
+  std::memcpy(quant, im.data + 4, 8);
+  const cv::Mat buffer(1, static_cast<int>(im.data_size - kHeader), CV_8UC1,
+                       const_cast<uint8_t*>(im.data + kHeader));
+  const cv::Mat raw = Decode(buffer, where);
+  if (raw.empty() || raw.type() != CV_16UC1) {
+    throw std::runtime_error(where + "compressedDepth data does not decode to a 16-bit PNG");
+  }
+  cv::Mat metres(raw.size(), CV_32FC1);
+  const bool inverse = f.rfind("32FC1", 0) == 0;
+  if (!inverse && f.rfind("16UC1", 0) != 0) {
+    throw std::runtime_error(where + "compressedDepth of '" + f + "' (16UC1 or 32FC1 only)");
+  }
+  for (int y = 0; y < raw.rows; ++y) {
+    const uint16_t* in = raw.ptr<uint16_t>(y);
+    float* out = metres.ptr<float>(y);
+    for (int x = 0; x < raw.cols; ++x) {
+      float v = 0;
+      if (in[x] != 0) v = inverse ? quant[0] / (static_cast<float>(in[x]) - quant[1]) : in[x] * 0.001f;
+      out[x] = std::isfinite(v) && v > 0 ? v : 0.0f;
+    }
   }
   return metres;
 }

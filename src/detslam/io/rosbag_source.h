@@ -16,8 +16,10 @@
 namespace detslam {
 
 struct RosbagOptions {
-  std::string rgb_topic = "/camera/rgb/image_color";  // rgb8, bgr8, mono8 (also rgba8, bgra8)
-  std::string depth_topic = "/camera/depth/image";    // 32FC1 metres or 16UC1 millimetres
+  // sensor_msgs/Image rgb8, bgr8, mono8 (also rgba8, bgra8), or CompressedImage (JPEG, PNG)
+  std::string rgb_topic = "/camera/rgb/image_color";
+  // sensor_msgs/Image 32FC1 metres or 16UC1 millimetres, or CompressedImage (compressedDepth)
+  std::string depth_topic = "/camera/depth/image";
   std::string camera_info_topic = "/camera/rgb/camera_info";  // optional in the bag
   double max_difference_s = 0.02;  // colour<->depth association window (TUM associate.py), s
   double offset_s = 0.0;           // added to depth stamps before association, seconds
@@ -56,6 +58,8 @@ class RosbagSource : public RgbdSource {
     size_t rgb = 0, depth = 0;  // indices into bag_->messages()
     Timestamp rgb_stamp, depth_stamp;
   };
+  bool Compressed(const RosbagMessage& m) const;  // a CompressedImage message
+
   std::string path_;
   RosbagOptions options_;
   std::shared_ptr<const RosbagFile> bag_;
@@ -81,5 +85,12 @@ Settings SettingsFromCameraInfo(const RosCameraInfo& info, const std::string& so
 // another encoding, a size of 0 or over 16384, or a row step shorter than a row.
 cv::Mat RosImageToBgr(const RosImage& image, const std::string& where = "");
 cv::Mat RosImageToDepthMetres(const RosImage& image, const std::string& where = "");
+// The same from sensor_msgs/CompressedImage: colour JPEG or PNG (8-bit, 1, 3 or 4 channels), and
+// depth in image_transport's compressedDepth form: a 12-byte header (int32 format, float
+// depthQuantA, depthQuantB) then a 16-bit PNG, millimetres for "16UC1; compressedDepth", for
+// "32FC1; compressedDepth" quantised inverse depth (depth = depthQuantA / (v - depthQuantB), v = 0
+// missing). Throw std::runtime_error starting with `where` when the data does not decode.
+cv::Mat RosCompressedToBgr(const RosCompressedImage& image, const std::string& where = "");
+cv::Mat RosCompressedToDepthMetres(const RosCompressedImage& image, const std::string& where = "");
 
 }  // namespace detslam

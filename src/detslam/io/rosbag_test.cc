@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "detslam/core/check.h"
@@ -144,6 +145,71 @@ TEST(RosbagSource, DepthEncodingsStepPaddingAndByteOrder) {
   EXPECT_EQ(b.depth_m.at<float>(1, 1), 0.0f);  // NaN: missing
   EXPECT_EQ(b.depth_m.at<float>(1, 2), 0.0f);  // negative: missing
   EXPECT_EQ(b.depth_m.at<float>(3, 3), nan_depth.at<float>(3, 3));
+}
+
+TEST(RosbagSource, CompressedColourAndDepth) {
+  BagWriter w;
+  const uint32_t rgb = w.AddConnection(kRgb, "sensor_msgs/CompressedImage");
+  const uint32_t depth = w.AddConnection(kDepth, "sensor_msgs/CompressedImage");
+  cv::Mat mm(kHeight, kWidth, CV_16UC1);
+  for (int y = 0; y < kHeight; ++y)
+    for (int x = 0; x < kWidth; ++x) mm.at<uint16_t>(y, x) = static_cast<uint16_t>(900 + 250 * x + 3 * y);
+  mm.at<uint16_t>(0, 0) = 0;
+  std::vector<uint8_t> png, depth_png;
+  cv::imencode(".png", Colour(4), png);
+  cv::imencode(".png", mm, depth_png);
+  // compressedDepth: int32 format, float depthQuantA, depthQuantB, then the PNG.
+  const auto compressed_depth = [](const std::vector<uint8_t>& encoded, float a, float b) {
+    testing::Bytes h;
+    h.U32(0);
+    h.Raw(&a, 4).Raw(&b, 4).Raw(encoded);
+    return h.bytes();
+  };
+  w.Write(rgb, Stamp(1), testing::CompressedImageMessage(Stamp(1), "rgb8; png compressed bgr8", png));
+  w.Write(depth, Stamp(1), testing::CompressedImageMessage(Stamp(1), "16UC1; compressedDepth png",
+                                                           compressed_depth(depth_png, 0, 0)));
+  // 32FC1 as image_transport quantises it: v = A / depth + B (A = z0 (z0 + 1), B = 1 - A / max).
+  const float a = 100.0f * 101.0f, b = 1.0f - a / 10.0f;
+  cv::Mat inverse(kHeight, kWidth, CV_16UC1);
+  const cv::Mat metres = DepthMetres(2);
+  for (int y = 0; y < kHeight; ++y)
+    for (int x = 0; x < kWidth; ++x) {
+      const float d = metres.at<float>(y, x);
+      inverse.at<uint16_t>(y, x) = d > 0 ? static_cast<uint16_t>(std::lround(a / d + b)) : 0;
+    }
+  std::vector<uint8_t> inverse_png, jpeg;
+  cv::imencode(".png", inverse, inverse_png);
+  cv::imencode(".jpg", Colour(5), jpeg, {cv::IMWRITE_JPEG_QUALITY, 100});
+  w.Write(rgb, Stamp(2), testing::CompressedImageMessage(Stamp(2), "jpeg", jpeg));
+  w.Write(depth, Stamp(2), testing::CompressedImageMessage(Stamp(2), "32FC1; compressedDepth png",
+                                                           compressed_depth(inverse_png, a, b)));
+  const RosbagSource s = RosbagSource::Open(testing::WriteBagFile(w.Finish(), "bag_compressed.bag"), {});
+  ASSERT_EQ(s.size(), 2u);
+  const RgbdImages png_frame = s.Load(0, Camera());
+  EXPECT_EQ(cv::norm(png_frame.bgr, Colour(4), cv::NORM_INF), 0);  // PNG: lossless
+  cv::Mat expected;
+  mm.convertTo(expected, CV_32F, 0.001);
+  EXPECT_LT(cv::norm(png_frame.depth_m, expected, cv::NORM_INF), 1e-6);
+  const RgbdImages jpeg_frame = s.Load(1, Camera());
+  EXPECT_LT(cv::norm(jpeg_frame.bgr, Colour(5), cv::NORM_L1) / (kWidth * kHeight * 3), 4.0);
+  EXPECT_EQ(jpeg_frame.depth_m.at<float>(0, 0), 0.0f);  // missing stays missing
+  // Quantisation step at depth d: d^2 / A (under 0.3 mm at 1.8 m here).
+  EXPECT_LT(cv::norm(jpeg_frame.depth_m, metres, cv::NORM_INF), 5e-4);
+
+  // Formats that are not read: a clear error naming topic and stamp.
+  BagWriter bad;
+  const uint32_t r2 = bad.AddConnection(kRgb, "sensor_msgs/CompressedImage");
+  const uint32_t d2 = bad.AddConnection(kDepth, "sensor_msgs/CompressedImage");
+  bad.Write(r2, Stamp(1), testing::CompressedImageMessage(Stamp(1), "png", png));
+  bad.Write(d2, Stamp(1), testing::CompressedImageMessage(Stamp(1), "png", depth_png));
+  const RosbagSource b2 = RosbagSource::Open(testing::WriteBagFile(bad.Finish(), "bag_bad_depth.bag"), {});
+  try {
+    b2.Load(0, Camera());
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("compressed depth format 'png' is not read"));
+    EXPECT_THAT(e.what(), HasSubstr("topic " + kDepth));
+  }
 }
 
 TEST(RosbagSource, UnsortedMessagesAreOrderedByHeaderStamp) {
