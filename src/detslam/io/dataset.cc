@@ -183,18 +183,9 @@ RgbdImages RgbdDataset::Load(size_t i, const PinholeCamera& camera) const {
   if (colour.depth() != CV_8U) {
     throw InputError(f.rgb_path, 0, "colour image must be 8-bit, got " + DescribeMat(colour));
   }
-  switch (colour.channels()) {
-    case 1:
-      cv::cvtColor(colour, out.bgr, cv::COLOR_GRAY2BGR);
-      break;
-    case 3:
-      out.bgr = colour;
-      break;
-    case 4:
-      cv::cvtColor(colour, out.bgr, cv::COLOR_BGRA2BGR);
-      break;
-    default:
-      throw InputError(f.rgb_path, 0, "unsupported colour image: " + DescribeMat(colour));
+  out.bgr = DecodedToBgr(colour);
+  if (out.bgr.empty()) {
+    throw InputError(f.rgb_path, 0, "unsupported colour image: " + DescribeMat(colour));
   }
   if (out.bgr.cols != camera.width || out.bgr.rows != camera.height) {
     throw InputError(f.rgb_path, 0,

@@ -20,6 +20,10 @@ struct RgbdImages {
 // "640x480": an image size in messages.
 std::string ImageSizeText(int width, int height);
 
+// A decoded 8-bit image (OpenCV order: grey, BGR or BGRA) as BGR; an empty Mat for another
+// channel count (the caller names the file in its error).
+cv::Mat DecodedToBgr(const cv::Mat& decoded);
+
 class RgbdSource {
  public:
   virtual ~RgbdSource() = default;

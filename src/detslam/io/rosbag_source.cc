@@ -314,20 +314,12 @@ cv::Mat RosCompressedToBgr(const RosCompressedImage& im, const std::string& wher
     throw std::runtime_error(where + "compressed colour image (format '" + im.format +
                              "') does not decode to an 8-bit image");
   }
-  cv::Mat bgr;
-  switch (decoded.channels()) {
-    case 1:
-      cv::cvtColor(decoded, bgr, cv::COLOR_GRAY2BGR);
-      return bgr;
-    case 3:
-      return decoded;  // imdecode gives BGR for JPEG and PNG
-    case 4:
-      cv::cvtColor(decoded, bgr, cv::COLOR_BGRA2BGR);
-      return bgr;
-    default:
-      throw std::runtime_error(where + "compressed colour image with " +
-                               std::to_string(decoded.channels()) + " channels");
+  cv::Mat bgr = DecodedToBgr(decoded);  // imdecode gives BGR for JPEG and PNG
+  if (bgr.empty()) {
+    throw std::runtime_error(where + "compressed colour image with " +
+                             std::to_string(decoded.channels()) + " channels");
   }
+  return bgr;
 }
 
 cv::Mat RosCompressedToDepthMetres(const RosCompressedImage& im, const std::string& where) {
