@@ -10,6 +10,8 @@
 #include <memory>
 
 #include "commands.h"
+#include "dense_args.h"
+#include "source_args.h"
 #include "detslam/core/check.h"
 #include "detslam/io/dataset.h"
 #include "detslam/io/rosbag_source.h"
@@ -23,15 +25,10 @@ namespace detslam::app {
 namespace {
 
 struct RunArgs {
-  std::string dataset;
-  std::string rosbag;
-  RosbagOptions bag;  // topics
-  std::string config;
+  SourceArgs from;  // --dataset or --rosbag, --config
   std::string out = "out";
-  std::string association;
   uint64_t seed = 42;
   int64_t max_frames = -1;
-  double max_dt = 0.02;
   bool no_progress = false;
   std::string save_map;
   std::string load_map;
@@ -47,6 +44,8 @@ struct RunArgs {
   int segment_every = 0;  // 0: from the settings (Segmentation.EveryK, default 1)
   std::string vocabulary;  // empty: from the settings (Place.Vocabulary, default the shipped one)
   std::vector<std::string> overrides;  // --set KEY=VALUE
+  std::string dense_map;               // --dense-map FILE.ply
+  TsdfOptions dense;
 };
 
 // A one-line progress bar on stderr when it is a terminal; otherwise a log line every 100 frames.
@@ -116,27 +115,10 @@ class StopSignals {
 
 void Run(const RunArgs& a) {
   namespace fs = std::filesystem;
-  if (a.dataset.empty() == a.rosbag.empty()) {
-    throw InputError("name the frames to run on: --dataset DIR (TUM layout) or --rosbag FILE");
-  }
-  std::unique_ptr<RgbdSource> source;
-  Settings settings;
-  bool bag_has_tf = false;
-  if (!a.rosbag.empty()) {
-    if (!a.association.empty()) throw InputError("--association is for --dataset folders only");
-    RosbagOptions bopt = a.bag;
-    bopt.max_difference_s = a.max_dt;
-    auto bag = std::make_unique<RosbagSource>(RosbagSource::Open(a.rosbag, bopt));
-    settings = a.config.empty() ? SettingsForBag(a.rosbag, bag->camera_info()) : ReadSettings(a.config);
-    bag_has_tf = bag->has_tf();
-    source = std::move(bag);
-  } else {
-    DatasetOptions dopt;
-    dopt.max_difference_s = a.max_dt;
-    dopt.association_file = a.association;
-    source = std::make_unique<RgbdDataset>(RgbdDataset::Open(a.dataset, dopt));
-    settings = a.config.empty() ? PresetForDataset(a.dataset) : ReadSettings(a.config);
-  }
+  OpenedSource opened = OpenSource(a.from);
+  const std::unique_ptr<RgbdSource> source = std::move(opened.source);
+  Settings settings = std::move(opened.settings);
+  const bool bag_has_tf = opened.bag_has_tf;
   const RgbdSource& dataset = *source;
   ApplySettingOverrides(a.overrides, &settings);
   const ResolvedSettings resolved = ResolveSettings(settings);  // rejects bad or unknown keys
@@ -145,6 +127,8 @@ void Run(const RunArgs& a) {
   options.max_frames = a.max_frames;
   options.save_map = a.save_map;
   options.load_map = a.load_map;
+  options.dense_map = a.dense_map;
+  options.dense = a.dense;
   options.threaded = a.threaded;
   options.slam = SlamOptionsFromSettings(settings, a.seed);
   options.mapping_thread = a.threaded && !a.inline_mapping;
@@ -177,6 +161,7 @@ void Run(const RunArgs& a) {
               settings.source.c_str());
   ProgressBar bar(!a.no_progress);
   options.stop = &g_stop;
+  options.dense_progress = [&](size_t done, size_t total) { DenseProgress(done, total, !a.no_progress); };
   RunSummary s;
   {
     const StopSignals signals;
@@ -198,13 +183,14 @@ void Run(const RunArgs& a) {
   std::printf("outputs: %s %s %s %s\n", (out / "trajectory.txt").c_str(), (out / "keyframes.txt").c_str(),
               (out / "map.ply").c_str(), (out / "run.json").c_str());
   if (!a.save_map.empty()) std::printf("map file: %s (%.1f MB)\n", a.save_map.c_str(), s.map_file_bytes / 1e6);
+  if (!a.dense_map.empty()) PrintDenseSummary(a.dense_map, s.dense, s.keyframe_masks, !s.segmenter.empty());
   if (!dataset.groundtruth_path().empty()) {
     std::printf("evaluate: detslam eval --gt %s --est %s --frames %s\n", dataset.groundtruth_path().c_str(),
                 (out / "trajectory.txt").c_str(), dataset.name().c_str());
   }
   if (bag_has_tf) {
     std::printf("ground truth (if the bag's tf holds it): detslam rosbag groundtruth %s --out %s, then detslam eval --gt %s --est %s\n",
-                a.rosbag.c_str(), (out / "groundtruth.txt").c_str(), (out / "groundtruth.txt").c_str(),
+                a.from.rosbag.c_str(), (out / "groundtruth.txt").c_str(), (out / "groundtruth.txt").c_str(),
                 (out / "trajectory.txt").c_str());
   }
   if (s.interrupted) {
@@ -218,19 +204,8 @@ void Run(const RunArgs& a) {
 void AddRunCommand(CLI::App& app) {
   auto args = std::make_shared<RunArgs>();
   auto* cmd = app.add_subcommand("run", "Run RGB-D SLAM on a TUM/Bonn-layout folder or a ROS 1 bag");
-  auto* dataset = cmd->add_option("--dataset", args->dataset, "Folder with rgb.txt, depth.txt (and groundtruth.txt)");
-  cmd->add_option("--rosbag", args->rosbag,
-                  "ROS 1 bag (format 2.0; uncompressed, bz2 or lz4 chunks) with colour and depth sensor_msgs/Image topics, instead of --dataset")
-      ->excludes(dataset);
-  cmd->add_option("--rgb-topic", args->bag.rgb_topic, "With --rosbag: colour topic (rgb8, bgr8, rgba8, bgra8, mono8)")->capture_default_str();
-  cmd->add_option("--depth-topic", args->bag.depth_topic, "With --rosbag: depth topic (32FC1 metres or 16UC1 millimetres)")->capture_default_str();
-  cmd->add_option("--camera-info-topic", args->bag.camera_info_topic,
-                  "With --rosbag: camera intrinsics, used when there is no --config and the bag's file name names no preset")
-      ->capture_default_str();
-  cmd->add_option("--config", args->config, "ORB-SLAM3-style settings YAML (default: preset from the folder or bag name; for a bag otherwise its camera info)");
+  AddSourceOptions(cmd, &args->from);
   cmd->add_option("--out", args->out, "Output folder")->capture_default_str();
-  cmd->add_option("--association", args->association, "Explicit rgb/depth association file");
-  cmd->add_option("--max-dt", args->max_dt, "rgb/depth association window in seconds")->capture_default_str();
   cmd->add_option("--seed", args->seed, "Seed for RANSAC (runs are deterministic per seed)")->capture_default_str();
   cmd->add_option("--max-frames", args->max_frames, "Stop after N frames");
   cmd->add_option("--segmenter", args->segmenter,
@@ -260,6 +235,9 @@ void AddRunCommand(CLI::App& app) {
                   "Start from the map in this map file (written by --save-map with the same camera, ORB settings and vocabulary): relocalise in it, then extend it");
   cmd->add_flag("--localization", args->localization,
                 "With --load-map: track against the loaded map only (no new keyframes or map points)");
+  cmd->add_option("--dense-map", args->dense_map,
+                  "After the run, fuse the keyframes at their final poses, without the dynamic objects' pixels, into a TSDF volume and write its surface here (PLY point cloud with colours and normals)");
+  AddDenseOptions(cmd, &args->dense);
   cmd->callback([args] { Run(*args); });
 }
 

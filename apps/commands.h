@@ -24,5 +24,6 @@ void AddSettingsCommand(CLI::App& app);
 void AddVocabCommand(CLI::App& app);
 void AddMapCommand(CLI::App& app);
 void AddRosbagCommand(CLI::App& app);
+void AddDensifyCommand(CLI::App& app);
 
 }  // namespace detslam::app

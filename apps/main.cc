@@ -28,6 +28,7 @@ int main(int argc, char** argv) {
   detslam::app::AddVocabCommand(app);
   detslam::app::AddMapCommand(app);
   detslam::app::AddRosbagCommand(app);
+  detslam::app::AddDensifyCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -2,7 +2,7 @@
 """Writes the README's benchmark summary table from the measured tables in docs/BENCHMARKS.md.
 
 The numbers come only from the sections the benchmark commands wrote (slam, dynamic, atlas-cover,
-atlas-files); this script
+atlas-files, dense); this script
 condenses them (per preset: seeds, frames tracked, ATE ratio to the static twin) and names the
 sections and their dates. The benchmark commands call it at the end; it can also be run alone.
 Usage: bench/readme_summary.py
@@ -127,10 +127,19 @@ def summary(bench_text):
                 rows.append((f"Map file (static, synthetic): {r['run']}",
                              f"{r['frames tracked']} tracked, {r['keyframes added']} keyframes added",
                              f"ATE RMSE {r['ATE RMSE mm']} mm, {r['ATE / SLAM run of that path']}x the SLAM run's"))
+    dense = section(bench_text, "dense")
+    if dense:
+        table = next((t for t in tables(dense) if t and "on people, filter %" in t[0]), [])
+        for r in table:
+            rows.append((f"Dense static map (synthetic {r['preset']}, 3 evaluation seeds)",
+                         f"{r['points (k)'].split()[0]}k points, completeness {r['completeness %'].split()[0]} %",
+                         f"on people {r['on people, filter %']} % (no filter: "
+                         f"{r['on people, no filter, no carving %'].split()[0]} %); median distance to the "
+                         f"scene {r['median distance mm']} mm"))
     lines = ["| benchmark | frames | accuracy |", "|---|---|---|"]
     lines += [f"| {a} | {b} | {c} |" for a, b, c in rows]
     sources = []
-    for name in ("slam", "dynamic", "atlas-cover", "atlas-files"):
+    for name in ("slam", "dynamic", "atlas-cover", "atlas-files", "dense"):
         body = section(bench_text, name)
         if body:
             sources.append(f"`{name}` ({stamp_date(body)})")

@@ -45,4 +45,17 @@ Alignment AlignPointSets(const std::vector<Eigen::Vector3d>& a,
   return out;
 }
 
+Rigid3d AlignPoseSets(const std::vector<Rigid3d>& a, const std::vector<Rigid3d>& b) {
+  DETSLAM_CHECK(a.size() == b.size() && !a.empty());
+  Eigen::Matrix3d sum = Eigen::Matrix3d::Zero();
+  for (size_t i = 0; i < a.size(); ++i) sum += b[i].RotationMatrix() * a[i].RotationMatrix().transpose();
+  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(sum, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Eigen::Matrix3d fix = Eigen::Matrix3d::Identity();
+  fix(2, 2) = (svd.matrixU() * svd.matrixV().transpose()).determinant() < 0 ? -1.0 : 1.0;
+  const Eigen::Matrix3d R = svd.matrixU() * fix * svd.matrixV().transpose();
+  Eigen::Vector3d t = Eigen::Vector3d::Zero();
+  for (size_t i = 0; i < a.size(); ++i) t += b[i].translation() - R * a[i].translation();
+  return Rigid3d(R, t / static_cast<double>(a.size()));
+}
+
 }  // namespace detslam

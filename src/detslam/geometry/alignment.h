@@ -25,6 +25,13 @@ struct Alignment {
 Alignment AlignPointSets(const std::vector<Eigen::Vector3d>& a,
                          const std::vector<Eigen::Vector3d>& b, bool with_scale);
 
+// The rigid b_from_a that best maps poses a_i (world_a_from_cam) onto b_i (world_b_from_cam):
+// rotation R = the chordal mean of R_b_i R_a_i^T (SVD projection of their sum onto SO(3)),
+// translation t = mean(p_b_i - R p_a_i). Unlike AlignPointSets it is well defined when the
+// positions do not span space (a camera that barely moves), e.g. to place a map made along a
+// trajectory into the ground truth's frame. Requires a.size() == b.size() >= 1 (CHECK).
+Rigid3d AlignPoseSets(const std::vector<Rigid3d>& a, const std::vector<Rigid3d>& b);
+
 // s * (R p + 0) + t, i.e. the aligned position of a point of set a in frame b.
 inline Eigen::Vector3d ApplyAlignment(const Alignment& alignment, const Eigen::Vector3d& p_a) {
   return alignment.scale * (alignment.b_from_a.RotationMatrix() * p_a) +

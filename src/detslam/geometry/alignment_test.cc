@@ -92,5 +92,22 @@ TEST(AlignPointSetsDeathTest, RejectsTooFewOrMismatchedPoints) {
   EXPECT_DEATH(AlignPointSets(kA, {V(0, 0, 0), V(1, 0, 0), V(0, 1, 0)}, false), "");
 }
 
+TEST(AlignPoseSets, RecoversAMotionFromPosesThatDoNotMove) {
+  // Three poses at one position, turned about different axes: positions alone cannot fix the
+  // rotation; orientations do.
+  const Rigid3d b_from_a(Eigen::Quaterniond(Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized())),
+                         Eigen::Vector3d(0.5, -1.0, 2.0));
+  std::vector<Rigid3d> a, b;
+  for (const Eigen::Vector3d axis : {Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitY(), Eigen::Vector3d::UnitZ()}) {
+    a.push_back(Rigid3d(Eigen::Quaterniond(Eigen::AngleAxisd(0.3, axis)), Eigen::Vector3d(1, 1, 1)));
+    b.push_back(b_from_a * a.back());
+  }
+  const Rigid3d found = AlignPoseSets(a, b);
+  EXPECT_LT((found.RotationMatrix() - b_from_a.RotationMatrix()).norm(), 1e-12);
+  EXPECT_LT((found.translation() - b_from_a.translation()).norm(), 1e-12);
+  const Rigid3d one = AlignPoseSets({a[0]}, {b[0]});  // a single pose fixes it too
+  EXPECT_LT((one.translation() - b_from_a.translation()).norm(), 1e-12);
+}
+
 }  // namespace
 }  // namespace detslam

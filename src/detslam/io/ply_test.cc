@@ -99,5 +99,55 @@ TEST(Ply, ColourCountMismatchIsAnErrorNamingTheFile) {
   EXPECT_FALSE(fs::exists(path));
 }
 
+TEST(Ply, NormalsAndColoursRoundTripThroughTheReader) {
+  const std::string path = TempPath("normals.ply");
+  const std::vector<Eigen::Vector3d> points = {{1.5, -2.25, 3.0}, {0.0, 0.5, 7.0}};
+  const std::vector<Color> colors = {Color(255, 10, 0), Color(1, 2, 3)};
+  const std::vector<Eigen::Vector3d> normals = {{0, 0, 1}, {0.6, 0.8, 0}};
+  WritePointCloudPly(path, points, colors, normals);
+  const PlyFile raw = ReadPly(path);
+  EXPECT_THAT(raw.header, ::testing::Contains("property float nx"));
+  EXPECT_EQ(raw.body.size(), 2u * 27u);
+  const PointCloud cloud = ReadPointCloudPly(path);
+  ASSERT_EQ(cloud.points.size(), 2u);
+  ASSERT_EQ(cloud.colors.size(), 2u);
+  ASSERT_EQ(cloud.normals.size(), 2u);
+  EXPECT_EQ(cloud.points[0], points[0]);
+  EXPECT_EQ(cloud.points[1], points[1]);
+  EXPECT_EQ(cloud.colors[0], colors[0]);
+  EXPECT_NEAR((cloud.normals[1] - normals[1]).norm(), 0, 1e-7);
+  WritePointCloudPly(path, points, {});
+  const PointCloud plain = ReadPointCloudPly(path);
+  EXPECT_EQ(plain.points.size(), 2u);
+  EXPECT_TRUE(plain.colors.empty());
+  EXPECT_TRUE(plain.normals.empty());
+  fs::remove(path);
+}
+
+TEST(Ply, ReaderNamesTheFileForTruncatedOrForeignFiles) {
+  const std::string path = TempPath("cut.ply");
+  WritePointCloudPly(path, {{1, 2, 3}, {4, 5, 6}}, {});
+  fs::resize_file(path, fs::file_size(path) - 5);
+  EXPECT_THAT([&] { ReadPointCloudPly(path); },
+              ::testing::ThrowsMessage<InputError>(::testing::AllOf(
+                  ::testing::HasSubstr(path), ::testing::HasSubstr("ends after 1 of 2"))));
+  {
+    std::ofstream out(path);
+    out << "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nend_header\n1\n";
+  }
+  EXPECT_THAT([&] { ReadPointCloudPly(path); },
+              ::testing::ThrowsMessage<InputError>(::testing::AllOf(
+                  ::testing::HasSubstr(path + ":2"), ::testing::HasSubstr("binary_little_endian"))));
+  {
+    std::ofstream out(path);
+    out << "ply\nformat binary_little_endian 1.0\nelement vertex 1\nproperty float x\nend_header\n";
+  }
+  EXPECT_THAT([&] { ReadPointCloudPly(path); },
+              ::testing::ThrowsMessage<InputError>(::testing::HasSubstr("no vertex property y")));
+  EXPECT_THAT([&] { ReadPointCloudPly(TempPath("missing.ply")); },
+              ::testing::ThrowsMessage<InputError>(::testing::HasSubstr("cannot open")));
+  fs::remove(path);
+}
+
 }  // namespace
 }  // namespace detslam

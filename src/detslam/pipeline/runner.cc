@@ -15,6 +15,7 @@
 
 #include "detslam/core/atomic_file.h"
 #include "detslam/core/check.h"
+#include "detslam/dynamic/dynamic_filter.h"
 #include "detslam/io/ply.h"
 #include "detslam/pipeline/bounded_queue.h"
 #include "detslam/pipeline/settings_keys.h"
@@ -28,8 +29,38 @@ nlohmann::json StatsJson(const ErrorStats& s) {
           {"std_ms", s.std},  {"min_ms", s.min},       {"max_ms", s.max}};
 }
 
+// The main map's keyframes with their masks; writes the masks (keyframe_masks/) and the dense map
+// when asked for (summary.keyframe_masks, summary.dense).
+void WriteKeyframeProducts(const RgbdSource& dataset, const Settings& settings,
+                           const RunOptions& options, const SlamSystem& slam,
+                           const KeyframeMasks& masks, bool segmented, RunSummary& summary) {
+  namespace fs = std::filesystem;
+  if (!(options.keyframe_masks && segmented) && options.dense_map.empty()) return;
+  size_t loaded = 0;  // keyframes of a map loaded from another session (--load-map)
+  const std::vector<DenseKeyframe> keyframes =
+      MatchKeyframes(dataset, slam.KeyFrameTrajectory(), masks, &loaded);
+  if (options.keyframe_masks && segmented) {
+    KeyframeMasks kept;
+    for (const DenseKeyframe& kf : keyframes) {
+      if (!kf.exclude_png.empty()) kept[kf.frame] = kf.exclude_png;
+    }
+    WriteKeyframeMasks((fs::path(options.out_dir) / "keyframe_masks").string(), kept);
+    summary.keyframe_masks = kept.size();
+  }
+  if (options.dense_map.empty()) return;
+  summary.dense.not_in_source = loaded;
+  if (loaded > 0) {
+    spdlog::warn("dense map: {} keyframes of the loaded map are not frames of {}: left out", loaded,
+                 dataset.name());
+  }
+  const TsdfVolume volume = FuseKeyframes(dataset, settings.camera, keyframes, options.dense,
+                                          &summary.dense, options.dense_progress);
+  WriteDenseMap(volume, options.dense_map, &summary.dense);
+}
+
 void WriteOutputs(const RgbdSource& dataset, const Settings& settings, const RunOptions& options,
-                  const SlamSystem& slam, RunSummary& summary) {
+                  const SlamSystem& slam, const KeyframeMasks& masks, bool segmented,
+                  RunSummary& summary) {
   namespace fs = std::filesystem;
   const fs::path out(options.out_dir);
   const std::string header = "detslam trajectory (world_from_camera) of " + dataset.name() +
@@ -75,6 +106,7 @@ void WriteOutputs(const RgbdSource& dataset, const Settings& settings, const Run
   }
   WritePointCloudPly((out / "map.ply").string(), points, {});
   if (!options.save_map.empty()) summary.map_file_bytes = slam.SaveMap(options.save_map);
+  WriteKeyframeProducts(dataset, settings, options, slam, masks, segmented, summary);
   nlohmann::json j;
   j["dataset"] = dataset.name();
   j["settings"] = settings.source;
@@ -163,6 +195,25 @@ void WriteOutputs(const RgbdSource& dataset, const Settings& settings, const Run
                        {"map_points", summary.loaded_landmarks},
                        {"load_ms", summary.map_load_ms},
                        {"localization", options.slam.localization}};
+  }
+  if (segmented && options.keyframe_masks) j["keyframe_masks"] = summary.keyframe_masks;
+  if (!options.dense_map.empty()) {
+    const DenseMapStats& d = summary.dense;
+    j["dense_map"] = {{"path", options.dense_map},
+                      {"voxel_m", options.dense.voxel_m},
+                      {"truncation_m", options.dense.truncation_m},
+                      {"depth_range_m", {options.dense.min_depth_m, options.dense.max_depth_m}},
+                      {"min_weight", options.dense.min_weight},
+                      {"carve", options.dense.carve},
+                      {"keyframes_fused", d.keyframes},
+                      {"keyframes_unreadable", d.unreadable},
+                      {"keyframes_not_in_source", d.not_in_source},
+                      {"keyframes_masked", summary.keyframe_masks},
+                      {"points", d.points},
+                      {"blocks", d.blocks},
+                      {"memory_mb", d.memory_mb},
+                      {"fusion_s", d.fusion_s},
+                      {"extraction_s", d.extraction_s}};
   }
   j["vocabulary"] = slam.vocabulary_path();
   j["wall_s"] = summary.wall_s;
@@ -253,6 +304,12 @@ void CheckOutputs(const RunOptions& options) {
     CheckWritableFolder(std::filesystem::path(options.save_map).parent_path().string(),
                         "folder of the map file (--save-map)");
   }
+  if (!options.dense_map.empty()) {
+    CheckWritableFolder(std::filesystem::path(options.dense_map).parent_path().string(),
+                        "folder of the dense map (--dense-map)");
+    std::string error;
+    if (!options.dense.Check(&error)) throw InputError("dense map options: " + error);
+  }
 }
 
 bool StopRequested(const RunOptions& options) {
@@ -331,6 +388,17 @@ class RunRecorder {
     if (progress_) progress_(summary_.frames, total_, r);
   }
 
+  // A keyframe's pixels removed by the Det-SLAM stage (its instances' masks and depth step), kept
+  // PNG-encoded for keyframe_masks/ and the dense map; nothing when the frame was not segmented
+  // or nothing was removed.
+  void AddKeyframeMask(const RunOptions& options, int64_t frame,
+                       const std::vector<Instance>& instances, const cv::Mat& depth_m) {
+    if (instances.empty() || (!options.keyframe_masks && options.dense_map.empty())) return;
+    const cv::Mat mask =
+        DynamicIgnoreMask(instances, depth_m, depth_m.size(), options.slam.dynamic.filter);
+    if (cv::countNonZero(mask) > 0) masks_[static_cast<size_t>(frame)] = EncodeKeyframeMask(mask);
+  }
+
   // Starts `slam` from options.load_map (if any); recorded in the summary.
   void LoadMap(const RunOptions& options, SlamSystem* slam) {
     if (options.load_map.empty()) return;
@@ -373,7 +441,7 @@ class RunRecorder {
     summary_.total = ComputeErrorStats(total_ms_);
     summary_.wall_s =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    WriteOutputs(dataset, settings, options, slam, summary_);
+    WriteOutputs(dataset, settings, options, slam, masks_, segmenter != nullptr, summary_);
     return summary_;
   }
 
@@ -382,6 +450,7 @@ class RunRecorder {
   ProgressFn progress_;
   RunSummary summary_;
   std::vector<double> seg_, ext_, trk_, total_ms_;
+  KeyframeMasks masks_;
 };
 
 size_t FrameCount(const RgbdSource& dataset, const RunOptions& options) {
@@ -463,7 +532,10 @@ RunSummary RunSequential(const RgbdSource& dataset, const Settings& settings,
     FrameReport report;
     Frame frame = Extract(slam, dataset, loaded, &report);
     const KeyFrameId kf = slam.TrackFrame(std::move(frame), &report);
-    if (kf != kNoKeyFrame) slam.MapKeyFrame(kf, &report);
+    if (kf != kNoKeyFrame) {
+      recorder.AddKeyframeMask(options, loaded.index, loaded.instances, loaded.images.depth_m);
+      slam.MapKeyFrame(kf, &report);
+    }
     recorder.Add(report);
   }
   return recorder.Finish(dataset, settings, options, slam, start, segmenter);
@@ -483,6 +555,8 @@ RunSummary RunThreaded(const RgbdSource& dataset, const Settings& settings,
   struct Extracted {
     Frame frame;
     FrameReport report;
+    std::vector<Instance> instances;  // for the keyframe masks
+    cv::Mat depth_m;
   };
   BoundedQueue<LoadedFrame> loaded(options.queue_capacity);
   BoundedQueue<Extracted> extracted(options.queue_capacity);
@@ -513,6 +587,8 @@ RunSummary RunThreaded(const RgbdSource& dataset, const Settings& settings,
             e.report = SkippedReport(dataset, *f);
           } else {
             e.frame = Extract(slam, dataset, *f, &e.report);
+            e.instances = std::move(f->instances);
+            e.depth_m = f->images.depth_m;
           }
           if (!extracted.Push(std::move(e))) break;
         }
@@ -538,6 +614,7 @@ RunSummary RunThreaded(const RgbdSource& dataset, const Settings& settings,
           }
           const KeyFrameId kf = slam.TrackFrame(std::move(e->frame), &e->report);
           if (kf != kNoKeyFrame) {
+            recorder.AddKeyframeMask(options, e->report.index, e->instances, e->depth_m);
             if (!options.mapping_thread) {
               slam.MapKeyFrame(kf, &e->report);
             } else if (!keyframes.Push(kf)) {

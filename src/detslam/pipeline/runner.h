@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "detslam/core/stats.h"
+#include "detslam/dense/dense_fusion.h"
 #include "detslam/io/dataset.h"
 #include "detslam/io/settings.h"
 #include "detslam/pipeline/slam_system.h"
@@ -25,6 +26,15 @@ struct RunOptions {
   size_t queue_capacity = 4;    // frames buffered between the threaded stages
   std::string save_map;         // write the final map to this map file (empty: none)
   std::string load_map;         // start from the map in this map file (empty: a new map)
+  // The dense static map (dense/dense_fusion.h): after the run, the main map's keyframes are fused
+  // at their final poses, without the pixels the Det-SLAM stage removed, and written here (PLY;
+  // empty: none). dense_progress (may be empty) is told each keyframe fused.
+  std::string dense_map;
+  TsdfOptions dense;
+  DenseProgressFn dense_progress;
+  // With a segmenter: write each keyframe's removed pixels to out_dir/keyframe_masks/NNNNNN.png
+  // (the main map's keyframes; `detslam densify` reads them).
+  bool keyframe_masks = true;
   // When *stop becomes true (e.g. set by a signal handler): the frame in progress is finished,
   // frames still queued are dropped, a running global BA stops after its current iteration, and
   // the outputs of the frames processed so far are written (RunSummary::interrupted).
@@ -56,6 +66,8 @@ struct RunSummary {
   uint64_t loaded_keyframes = 0, loaded_landmarks = 0;  // of the map loaded (load_map)
   double map_load_ms = 0;                               // reading and restoring it
   std::vector<LoopRecord> loop_records;
+  size_t keyframe_masks = 0;  // written to out_dir/keyframe_masks
+  DenseMapStats dense;        // of the dense map (dense_map)
   double wall_s = 0;
   ErrorStats segmentation, extraction, tracking, mapping, total;  // per-stage times, ms
   std::string segmenter;  // backend name, empty without segmentation

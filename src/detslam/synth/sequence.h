@@ -58,6 +58,7 @@ class SyntheticSequence {
   int size() const { return frames_; }
   const SynthOptions& options() const { return options_; }
   const PinholeCamera& camera() const { return camera_; }
+  const synth::Scene& scene() const { return scene_; }  // the static world (its boxes)
 
   Timestamp StampOf(int k) const;
   Timestamp DepthStampOf(int k) const;
