@@ -9,11 +9,13 @@
 # Held-out protocol: the dense defaults (voxel 1 cm, truncation 4 cm, min weight 2, carving on)
 # were chosen on tuning seed 1 of walking_xyz; the published table holds evaluation seeds
 # (EVAL_SEEDS) nothing was chosen on, as mean, sd and worst over seeds. The tuning table shows the
-# min-weight choice on the tuning seeds (TUNE_SEEDS).
+# min-weight choice on the tuning seeds (TUNE_SEEDS). Seeds 101-103 were the evaluation seeds of
+# the first run and were looked at to diagnose its one miss (README, dense map), so they are no
+# longer held out.
 # Writes docs/BENCHMARKS.md (section dense) and docs/dense_map.png (the first evaluation seed of
 # walking_xyz with the filter and without it, no carving).
 # Usage: bench/bench_dense.sh [path/to/detslam]
-#   env: PRESETS="walking_xyz walking_static walking_rpy walking_halfsphere" EVAL_SEEDS="101 102 103"
+#   env: PRESETS="walking_xyz walking_static walking_rpy walking_halfsphere" EVAL_SEEDS="201 202 203"
 #        TUNE_SEEDS="1 2 3" FRAMES=300 JOBS=2
 set -euo pipefail
 here="$(cd "$(dirname "$0")" && pwd)"
@@ -22,7 +24,7 @@ bin="$(realpath "${1:-$root/build/bin/detslam}")"
 evaluator="$(dirname "$(dirname "$bin")")/bench/dense_eval"
 shared="${DETSLAM_SHARED:-$root/../shared}"
 presets="${PRESETS:-walking_xyz walking_static walking_rpy walking_halfsphere}"
-eval_seeds="${EVAL_SEEDS:-101 102 103}"
+eval_seeds="${EVAL_SEEDS:-201 202 203}"
 tune_seeds="${TUNE_SEEDS:-1 2 3}"
 frames="${FRAMES:-300}"
 jobs="${JOBS:-2}"

@@ -7,7 +7,8 @@
 // With --figure OUT.png, the first two clouds are drawn side by side as seen from 0.6 m behind the
 // sequence's first camera pose (perspective, z-buffered, their own colours) for the README.
 // Usage: dense_eval --preset P --seed S --frames N [--people DIR] --run RUN_DIR --json OUT
-//                   [--figure OUT.png] NAME=FILE.ply [NAME=FILE.ply ...]
+//                   [--figure OUT.png] [--smear-dir DIR] NAME=FILE.ply [NAME=FILE.ply ...]
+// --smear-dir writes each cloud's points counted as on people to DIR/NAME_smear.ply.
 #include <cstdio>
 #include <cstring>
 #include <fstream>
@@ -56,7 +57,7 @@ cv::Mat RenderCloud(const detslam::PointCloud& cloud, const std::vector<Eigen::V
 int Main(int argc, char** argv) {
   using namespace detslam;
   SynthOptions so;
-  std::string run_dir, json_path, figure;
+  std::string run_dir, json_path, figure, smear_dir;
   std::vector<std::pair<std::string, std::string>> clouds;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
@@ -71,6 +72,7 @@ int Main(int argc, char** argv) {
     else if (a == "--run") run_dir = next();
     else if (a == "--json") json_path = next();
     else if (a == "--figure") figure = next();
+    else if (a == "--smear-dir") smear_dir = next();
     else if (a.find('=') != std::string::npos) clouds.emplace_back(a.substr(0, a.find('=')), a.substr(a.find('=') + 1));
     else throw InputError("unknown argument " + a);
   }
@@ -102,7 +104,17 @@ int Main(int argc, char** argv) {
       panels.push_back(RenderCloud(cloud, points, view,
                                    name + ": " + std::to_string(points.size() / 1000) + "k points"));
     }
-    const DenseMapScore s = truth.Score(points);
+    std::vector<size_t> smear;
+    const DenseMapScore s = truth.Score(points, &smear);
+    if (!smear_dir.empty()) {  // the points on people, in the run's frame, for diagnosis
+      std::vector<Eigen::Vector3d> sp;
+      std::vector<Eigen::Matrix<uint8_t, 3, 1>> sc;
+      for (const size_t i : smear) {
+        sp.push_back(cloud.points[i]);
+        if (!cloud.colors.empty()) sc.push_back(cloud.colors[i]);
+      }
+      WritePointCloudPly(smear_dir + "/" + name + "_smear.ply", sp, sc);
+    }
     out["clouds"][name] = {{"points", s.points},
                            {"near_person", s.near_person},
                            {"near_person_fraction", s.NearPersonFraction()},

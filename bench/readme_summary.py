@@ -133,7 +133,7 @@ def summary(bench_text):
         for r in table:
             rows.append((f"Dense static map (synthetic {r['preset']}, 3 evaluation seeds)",
                          f"{r['points (k)'].split()[0]}k points, completeness {r['completeness %'].split()[0]} %",
-                         f"on people {r['on people, filter %']} % (no filter: "
+                         f"on people {r['on people, filter %']} % (no filter, no carving: "
                          f"{r['on people, no filter, no carving %'].split()[0]} %); median distance to the "
                          f"scene {r['median distance mm']} mm"))
     lines = ["| benchmark | frames | accuracy |", "|---|---|---|"]

@@ -27,9 +27,9 @@ mkdir -p "$OUT"
 echo "== 1/3 synthetic sequences: walking_xyz ($FRAMES frames, people walking) and its static twin"
 "$DETSLAM" synth --preset walking_xyz --seed 1 --frames "$FRAMES" "${PEOPLE[@]}" --out "$OUT/walking_xyz"
 "$DETSLAM" synth --preset walking_xyz --seed 1 --frames "$FRAMES" --no-people --out "$OUT/walking_xyz_static_twin"
-run() {  # name dataset segmenter
+run() {  # name dataset segmenter [run options]
   echo "== 2/3 SLAM: $1"
-  "$DETSLAM" run --dataset "$OUT/$2" --segmenter "$3" --threaded --out "$OUT/$1"
+  "$DETSLAM" run --dataset "$OUT/$2" --segmenter "$3" --threaded --out "$OUT/$1" "${@:4}"
   echo "== 3/3 evaluation: $1 (TUM conventions: 0.02 s association, SE(3) alignment, RPE over 1 s)"
   "$DETSLAM" eval --gt "$OUT/$2/groundtruth.txt" --est "$OUT/$1/trajectory.txt" --frames "$OUT/$2" \
     --json "$OUT/$1/eval.json" --plot "$OUT/$1/eval.svg"
@@ -37,7 +37,7 @@ run() {  # name dataset segmenter
 }
 run static_twin walking_xyz_static_twin none
 run people_no_filter walking_xyz none
-run people_detslam_$FILTER walking_xyz "$FILTER"
+run people_detslam_$FILTER walking_xyz "$FILTER" --dense-map "$OUT/people_detslam_$FILTER/dense_map.ply"
 echo
 echo "Summary:"
 for r in static_twin people_no_filter "people_detslam_$FILTER"; do
@@ -45,4 +45,5 @@ for r in static_twin people_no_filter "people_detslam_$FILTER"; do
 done
 echo "Outputs under $OUT/: <run>/trajectory.txt (TUM), keyframes.txt, map.ply, run.json,"
 echo "eval.json, eval.svg (trajectory and error plots) and report.html (the run with its plots;"
-echo "open it in a browser)."
+echo "open it in a browser); people_detslam_$FILTER/dense_map.ply is the dense static map with the"
+echo "people removed (open it in MeshLab or CloudCompare)."

@@ -148,7 +148,8 @@ DenseTruth::DenseTruth(const SyntheticSequence& sequence, const std::vector<int>
   }
 }
 
-DenseMapScore DenseTruth::Score(const std::vector<Eigen::Vector3d>& points) const {
+DenseMapScore DenseTruth::Score(const std::vector<Eigen::Vector3d>& points,
+                                std::vector<size_t>* smear) const {
   const DenseTruthOptions& o = options_;
   const std::vector<Eigen::Vector3d>& statics = statics_;
   const PointGrid& people = people_;
@@ -159,12 +160,17 @@ DenseMapScore DenseTruth::Score(const std::vector<Eigen::Vector3d>& points) cons
   std::vector<double> dist;
   dist.reserve(points.size());
   PointGrid cloud(o.completeness_radius_m);
-  for (const Eigen::Vector3d& p : points) {
+  if (smear) smear->clear();
+  for (size_t i = 0; i < points.size(); ++i) {
+    const Eigen::Vector3d& p = points[i];
     const double d = SceneSurfaceDistance(scene_, p);
     dist.push_back(d);
     if (people.AnyWithin(p, o.person_radius_m)) {
       ++s.near_person;
-      if (d > o.off_scene_m) ++s.near_person_off_scene;
+      if (d > o.off_scene_m) {
+        ++s.near_person_off_scene;
+        if (smear) smear->push_back(i);
+      }
     }
     cloud.Add(p);
   }

@@ -78,8 +78,10 @@ class DenseTruth {
   DenseTruth(const SyntheticSequence& sequence, const std::vector<int>& keyframes,
              const DenseTruthOptions& options,
              const std::function<void(int done, int total)>& progress = nullptr);
-  // Scores `points` (world frame of the sequence, i.e. already aligned).
-  DenseMapScore Score(const std::vector<Eigen::Vector3d>& points) const;
+  // Scores `points` (world frame of the sequence, i.e. already aligned). With `smear`, the indices
+  // of the points counted in near_person_off_scene are stored there (for diagnosis).
+  DenseMapScore Score(const std::vector<Eigen::Vector3d>& points,
+                      std::vector<size_t>* smear = nullptr) const;
 
  private:
   const synth::Scene& scene_;
