@@ -22,8 +22,8 @@ struct SourceArgs {
   double max_dt = 0.02;
 };
 
-// Adds --dataset, --rosbag, the topic options, --config, --association and --max-dt. With
-// `required`, one of --dataset and --rosbag must be given (checked by OpenSource).
+// Adds --dataset, --rosbag, the topic options, --config, --association and --max-dt (that one of
+// --dataset and --rosbag is given is checked by OpenSource).
 void AddSourceOptions(CLI::App* cmd, SourceArgs* args);
 
 struct OpenedSource {
