@@ -53,10 +53,8 @@ TsdfVolume FuseKeyframes(const RgbdSource& source, const PinholeCamera& camera,
     }
     cv::Mat exclude;
     if (!kf.exclude_png.empty()) {
-      exclude = cv::imdecode(cv::Mat(1, static_cast<int>(kf.exclude_png.size()), CV_8UC1,
-                                     const_cast<char*>(kf.exclude_png.data())),
-                             cv::IMREAD_UNCHANGED);
-      if (exclude.type() != CV_8UC1 || exclude.size() != images.depth_m.size()) {
+      exclude = DecodeKeyframeMask(kf.exclude_png);
+      if (exclude.empty() || exclude.size() != images.depth_m.size()) {
         throw InputError("dense map: the mask of frame " + std::to_string(kf.frame) +
                          " is not an 8-bit mask of the image's size");
       }
@@ -97,6 +95,14 @@ std::string EncodeKeyframeMask(const cv::Mat& mask) {
   std::vector<uint8_t> png;
   DETSLAM_CHECK(cv::imencode(".png", mask, png));
   return std::string(png.begin(), png.end());
+}
+
+cv::Mat DecodeKeyframeMask(const std::string& png) {
+  if (png.empty()) return cv::Mat();
+  const cv::Mat m = cv::imdecode(
+      cv::Mat(1, static_cast<int>(png.size()), CV_8UC1, const_cast<char*>(png.data())),
+      cv::IMREAD_UNCHANGED);
+  return m.type() == CV_8UC1 ? m : cv::Mat();
 }
 
 std::vector<DenseKeyframe> MatchKeyframes(const RgbdSource& source, const Trajectory& keyframe_poses,
@@ -152,12 +158,7 @@ KeyframeMasks ReadKeyframeMasks(const std::string& dir) {
     if (frame < 0) continue;
     std::ifstream in(entry.path(), std::ios::binary);
     std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-    const cv::Mat m =
-        bytes.empty() ? cv::Mat()
-                      : cv::imdecode(cv::Mat(1, static_cast<int>(bytes.size()), CV_8UC1,
-                                             const_cast<char*>(bytes.data())),
-                                     cv::IMREAD_UNCHANGED);
-    if (m.empty() || m.type() != CV_8UC1) {
+    if (DecodeKeyframeMask(bytes).empty()) {
       throw InputError(entry.path().string(), 0,
                        "not a keyframe mask (an 8-bit single-channel PNG)");
     }

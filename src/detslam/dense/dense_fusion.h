@@ -23,8 +23,10 @@ namespace detslam {
 // stage (kept encoded: a few kilobytes each instead of a full image per keyframe).
 using KeyframeMasks = std::map<size_t, std::string>;
 
-// A mask as the PNG bytes KeyframeMasks holds (CHECKs a CV_8UC1 mask).
+// A mask as the PNG bytes KeyframeMasks holds (CHECKs a CV_8UC1 mask), and back: an empty Mat
+// when the bytes are no 8-bit single-channel image (callers name the source in their error).
 std::string EncodeKeyframeMask(const cv::Mat& mask);
+cv::Mat DecodeKeyframeMask(const std::string& png);
 
 struct DenseKeyframe {
   size_t frame = 0;         // index in the RGB-D source

@@ -6,6 +6,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "detslam/core/check.h"
+#include "detslam/core/grid_key.h"
 
 namespace detslam {
 namespace {
@@ -44,29 +45,18 @@ TsdfVolume::TsdfVolume(const TsdfOptions& options) : options_(options) {
   DETSLAM_CHECK_MSG(options_.Check(&error), error);
 }
 
-uint64_t TsdfVolume::Key(const Eigen::Vector3i& b) {
-  // 21 bits per coordinate (offset to non-negative): +-1e6 blocks, far beyond any room.
-  const auto part = [](int v) { return static_cast<uint64_t>(v + (1 << 20)) & 0x1FFFFF; };
-  return part(b.x()) | (part(b.y()) << 21) | (part(b.z()) << 42);
-}
-
-TsdfVolume::Block* TsdfVolume::Find(const Eigen::Vector3i& block) {
-  const auto it = index_.find(Key(block));
-  return it == index_.end() ? nullptr : blocks_[it->second].get();
-}
-
 const TsdfVolume::Block* TsdfVolume::Find(const Eigen::Vector3i& block) const {
-  const auto it = index_.find(Key(block));
+  const auto it = index_.find(GridCellKey(block));
   return it == index_.end() ? nullptr : blocks_[it->second].get();
 }
 
-TsdfVolume::Block& TsdfVolume::FindOrAllocate(const Eigen::Vector3i& block) {
-  const auto [it, inserted] = index_.emplace(Key(block), blocks_.size());
+size_t TsdfVolume::FindOrAllocate(const Eigen::Vector3i& block) {
+  const auto [it, inserted] = index_.emplace(GridCellKey(block), blocks_.size());
   if (inserted) {
     blocks_.push_back(std::make_unique<Block>());
     blocks_.back()->coords = block;
   }
-  return *blocks_[it->second];
+  return it->second;
 }
 
 const TsdfVolume::Voxel* TsdfVolume::VoxelAt(const Eigen::Vector3i& v) const {
@@ -107,10 +97,8 @@ void TsdfVolume::Integrate(const PinholeCamera& camera, const Rigid3d& world_fro
   std::vector<size_t> visit;
   std::vector<char> listed(blocks_.size(), 0);
   const auto list_block = [&](const Eigen::Vector3i& b) {
-    const size_t before = blocks_.size();
-    FindOrAllocate(b);
-    const size_t i = index_.at(Key(b));
-    if (blocks_.size() != before) listed.push_back(0);
+    const size_t i = FindOrAllocate(b);
+    if (i == listed.size()) listed.push_back(0);  // allocated now
     if (!listed[i]) {
       listed[i] = 1;
       visit.push_back(i);
@@ -125,9 +113,7 @@ void TsdfVolume::Integrate(const PinholeCamera& camera, const Rigid3d& world_fro
       for (int s = 0; s < samples; ++s) {
         const float z = d - trunc + 2.f * trunc * s / static_cast<float>(samples - 1);
         const Eigen::Vector3f p = world_R_cam * (ray * z) + world_t_cam;
-        list_block(Eigen::Vector3i(static_cast<int>(std::floor(p.x() / block_m)),
-                                   static_cast<int>(std::floor(p.y() / block_m)),
-                                   static_cast<int>(std::floor(p.z() / block_m))));
+        list_block(GridCellOf(p, block_m));
       }
     }
   }

@@ -75,16 +75,15 @@ class TsdfVolume {
     Eigen::Vector3i coords;  // block index (voxel index / kBlockSide, rounded down)
     std::array<Voxel, kBlockVoxels> voxels;
   };
-  static uint64_t Key(const Eigen::Vector3i& block);
-  Block* Find(const Eigen::Vector3i& block);
   const Block* Find(const Eigen::Vector3i& block) const;
-  Block& FindOrAllocate(const Eigen::Vector3i& block);
+  // The block's position in blocks_, allocated if new.
+  size_t FindOrAllocate(const Eigen::Vector3i& block);
   // The voxel at a global voxel index, or null when its block is not allocated.
   const Voxel* VoxelAt(const Eigen::Vector3i& voxel) const;
 
   TsdfOptions options_;
   std::vector<std::unique_ptr<Block>> blocks_;      // in allocation order
-  std::unordered_map<uint64_t, size_t> index_;      // Key(block) -> position in blocks_
+  std::unordered_map<uint64_t, size_t> index_;      // GridCellKey(block) -> position in blocks_
   int integrated_ = 0;
 };
 

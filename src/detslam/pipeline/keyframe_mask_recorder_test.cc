@@ -2,8 +2,6 @@
 
 #include <gtest/gtest.h>
 
-#include <opencv2/imgcodecs.hpp>
-
 namespace detslam {
 namespace {
 
@@ -20,11 +18,6 @@ std::vector<Instance> PersonAt(const cv::Rect& box) {
 }
 
 cv::Mat Depth() { return cv::Mat(kSize, CV_32FC1, cv::Scalar(2.0f)); }
-
-cv::Mat Decode(const std::string& png) {
-  return cv::imdecode(cv::Mat(1, static_cast<int>(png.size()), CV_8UC1, const_cast<char*>(png.data())),
-                      cv::IMREAD_UNCHANGED);
-}
 
 DynamicFilterOptions NoDilation() {
   DynamicFilterOptions o;
@@ -45,12 +38,12 @@ TEST(KeyframeMaskRecorder, AKeyframeTakesThePeopleFoundInItsNextFrames) {
   recorder.AddFrame(20, true, PersonAt(cv::Rect(20, 10, 5, 5)), Depth());  // still waiting at the end
   const KeyframeMasks masks = recorder.Finish();
   ASSERT_EQ(masks.size(), 2u);
-  const cv::Mat m0 = Decode(masks.at(0));
+  const cv::Mat m0 = DecodeKeyframeMask(masks.at(0));
   ASSERT_EQ(m0.size(), kSize);
   EXPECT_EQ(cv::countNonZero(m0), 10 * 48);
   EXPECT_EQ(m0.at<uint8_t>(5, 5), 255);
   EXPECT_EQ(m0.at<uint8_t>(5, 55), 0);
-  EXPECT_EQ(cv::countNonZero(Decode(masks.at(20))), 25);
+  EXPECT_EQ(cv::countNonZero(DecodeKeyframeMask(masks.at(20))), 25);
   EXPECT_EQ(masks.count(10), 0u);
 }
 
@@ -61,7 +54,7 @@ TEST(KeyframeMaskRecorder, WithoutLookaheadOnlyTheKeyframesOwnPeopleCount) {
   recorder.AddFrame(2, true, PersonAt(cv::Rect(0, 0, 4, 4)), Depth());
   const KeyframeMasks masks = recorder.Finish();
   ASSERT_EQ(masks.size(), 1u);
-  EXPECT_EQ(cv::countNonZero(Decode(masks.at(2))), 16);
+  EXPECT_EQ(cv::countNonZero(DecodeKeyframeMask(masks.at(2))), 16);
 }
 
 }  // namespace

@@ -6,21 +6,11 @@
 #include <unordered_set>
 
 #include "detslam/core/check.h"
+#include "detslam/core/grid_key.h"
 #include "detslam/geometry/alignment.h"
 
 namespace detslam {
 namespace {
-
-uint64_t PackCell(const Eigen::Vector3i& c) {
-  const auto part = [](int v) { return static_cast<uint64_t>(v + (1 << 20)) & 0x1FFFFF; };
-  return part(c.x()) | (part(c.y()) << 21) | (part(c.z()) << 42);
-}
-
-Eigen::Vector3i CellOf(const Eigen::Vector3d& p, double cell) {
-  return Eigen::Vector3i(static_cast<int>(std::floor(p.x() / cell)),
-                         static_cast<int>(std::floor(p.y() / cell)),
-                         static_cast<int>(std::floor(p.z() / cell)));
-}
 
 double Quantile(std::vector<double> v, double q) {
   if (v.empty()) return 0;
@@ -86,9 +76,9 @@ Rigid3d AlignRunToSequence(const SyntheticSequence& sequence, const Trajectory& 
 PointGrid::PointGrid(double cell_m) : cell_(cell_m) { DETSLAM_CHECK(cell_m > 0); }
 
 uint64_t PointGrid::KeyOf(const Eigen::Vector3d& p, Eigen::Vector3i* cell) const {
-  const Eigen::Vector3i c = CellOf(p, cell_);
+  const Eigen::Vector3i c = GridCellOf(p, cell_);
   if (cell) *cell = c;
-  return PackCell(c);
+  return GridCellKey(c);
 }
 
 void PointGrid::Add(const Eigen::Vector3d& p) {
@@ -105,7 +95,7 @@ bool PointGrid::AnyWithin(const Eigen::Vector3d& p, double radius) const {
   for (int dz = -1; dz <= 1; ++dz) {
     for (int dy = -1; dy <= 1; ++dy) {
       for (int dx = -1; dx <= 1; ++dx) {
-        const auto it = cells_.find(PackCell(c + Eigen::Vector3i(dx, dy, dz)));
+        const auto it = cells_.find(GridCellKey(c + Eigen::Vector3i(dx, dy, dz)));
         if (it == cells_.end()) continue;
         for (const Eigen::Vector3f& x : it->second) {
           if ((x - q).squaredNorm() <= r2) return true;
@@ -136,7 +126,7 @@ DenseTruth::DenseTruth(const SyntheticSequence& sequence, const std::vector<int>
         const bool person = f.instance_mask.at<uint16_t>(v, u) != 0;
         if (person ? !people_frame : (!key || z < o.min_depth_m || z > o.max_depth_m)) continue;
         const Eigen::Vector3d pw = f.world_from_cam * cam.Unproject(Eigen::Vector2d(u, v), z);
-        const uint64_t cell = PackCell(CellOf(pw, o.sample_m));
+        const uint64_t cell = GridCellKey(GridCellOf(pw, o.sample_m));
         if (person) {
           if (person_cells.insert(cell).second) people_.Add(pw);
         } else if (static_cells.insert(cell).second) {
