@@ -12,6 +12,7 @@
 #include "commands.h"
 #include "dense_args.h"
 #include "source_args.h"
+#include "stop_signals.h"
 #include "detslam/core/check.h"
 #include "detslam/io/dataset.h"
 #include "detslam/io/rosbag_source.h"
@@ -20,6 +21,8 @@
 #include "detslam/pipeline/settings_keys.h"
 #include "detslam/segmentation/dnn_segmenter.h"
 #include "detslam/segmentation/segmenter_factory.h"
+#include "detslam/viewer/live_viewer.h"
+#include "detslam/viewer/viewer_server.h"
 
 namespace detslam::app {
 namespace {
@@ -46,7 +49,46 @@ struct RunArgs {
   std::vector<std::string> overrides;  // --set KEY=VALUE
   std::string dense_map;               // --dense-map FILE.ply
   TsdfOptions dense;
+  int viewer_port = -1;  // --viewer [PORT] (0: a free port; < 0: no viewer)
+  bool viewer_keep = false;
+  bool paused = false;
 };
+
+constexpr char kRunStopMessage[] =
+    "\ndetslam: stopping after the current frame and writing the outputs so far (again to quit "
+    "at once)\n";
+
+// The live viewer of a run (--viewer): its content and its web server.
+struct Viewer {
+  std::unique_ptr<LiveViewer> content;
+  std::unique_ptr<ViewerServer> server;
+};
+
+Viewer StartViewer(const RunArgs& a, const RgbdSource& dataset, const std::string& segmenter) {
+  Viewer v;
+  if (a.viewer_port < 0) return v;
+  if (a.threaded && a.paused) throw InputError("--paused needs a sequential run (no --threaded)");
+  LiveViewerOptions vo;
+  vo.title = dataset.name() + " (segmenter " + segmenter + ", " +
+             (a.threaded ? "threaded" : "sequential") + ")";
+  if (!dataset.groundtruth_path().empty()) {
+    try {
+      vo.ground_truth = ReadTumTrajectory(dataset.groundtruth_path());
+    } catch (const InputError& e) {
+      std::fprintf(stderr, "note: viewer without ground truth: %s\n", e.what());
+    }
+  }
+  vo.start_paused = a.paused;
+  vo.stop = &StopFlag();
+  v.content = std::make_unique<LiveViewer>(std::move(vo));
+  ViewerServerOptions so;
+  so.port = a.viewer_port;
+  v.server = std::make_unique<ViewerServer>(v.content.get(), so);
+  std::printf("viewer: %s (open it in a browser%s)\n", v.server->url().c_str(),
+              a.paused ? "; paused: press Step or Resume" : "");
+  std::fflush(stdout);
+  return v;
+}
 
 // A one-line progress bar on stderr when it is a terminal; otherwise a log line every 100 frames.
 class ProgressBar {
@@ -71,46 +113,6 @@ class ProgressBar {
 
  private:
   bool tty_;
-};
-
-// Ctrl-C (SIGINT) or SIGTERM during a run: the first asks the run to stop after the frame in
-// progress and write its outputs so far (run.json "interrupted": true; exit status 128 + signal);
-// a second one exits at once (outputs being written atomically keep their previous contents).
-std::atomic<bool> g_stop{false};
-volatile std::sig_atomic_t g_signal = 0;
-
-extern "C" void OnStopSignal(int sig) {
-  if (g_signal != 0) _exit(128 + sig);
-  g_signal = sig;
-  g_stop = true;
-  const char msg[] =
-      "\ndetslam: stopping after the current frame and writing the outputs so far (again to quit "
-      "at once)\n";
-  const ssize_t ignored = write(STDERR_FILENO, msg, sizeof(msg) - 1);
-  (void)ignored;
-}
-
-// Installs OnStopSignal for SIGINT and SIGTERM while it lives.
-class StopSignals {
- public:
-  StopSignals() {
-    static_assert(std::atomic<bool>::is_always_lock_free, "set from a signal handler");
-    struct sigaction sa;
-    std::memset(&sa, 0, sizeof(sa));
-    sa.sa_handler = OnStopSignal;
-    sigemptyset(&sa.sa_mask);
-    sigaction(SIGINT, &sa, &old_int_);
-    sigaction(SIGTERM, &sa, &old_term_);
-  }
-  ~StopSignals() {
-    sigaction(SIGINT, &old_int_, nullptr);
-    sigaction(SIGTERM, &old_term_, nullptr);
-  }
-  StopSignals(const StopSignals&) = delete;
-  StopSignals& operator=(const StopSignals&) = delete;
-
- private:
-  struct sigaction old_int_, old_term_;
 };
 
 void Run(const RunArgs& a) {
@@ -159,16 +161,19 @@ void Run(const RunArgs& a) {
   }
   std::printf("detslam run (%s, segmenter %s): %zu frames from %s (settings: %s)\n", a.threaded ? "threaded" : "sequential", spec.c_str(), dataset.size(), dataset.name().c_str(),
               settings.source.c_str());
+  if (a.paused && a.viewer_port < 0) throw InputError("--paused needs --viewer");
+  const Viewer viewer = StartViewer(a, dataset, spec);
+  options.observer = viewer.content.get();
   ProgressBar bar(!a.no_progress);
-  options.stop = &g_stop;
+  options.stop = &StopFlag();
   options.dense_progress = [&](size_t done, size_t total) { DenseProgress(done, total, !a.no_progress); };
   RunSummary s;
   {
-    const StopSignals signals;
+    const StopSignals signals(kRunStopMessage);
     s = Run(dataset, settings, options, [&](size_t d, size_t t, const FrameReport& r) { bar.Update(d, t, r); }, segmenter.get());
   }
   if (s.skipped > 0) std::printf("skipped %zu frames whose images could not be read (run.json skipped_frames)\n", s.skipped);
-  if (s.interrupted) std::printf("interrupted after %zu of %zu frames (signal %d): outputs of those frames written\n", s.frames, dataset.size(), static_cast<int>(g_signal));
+  if (s.interrupted) std::printf("interrupted after %zu of %zu frames (signal %d): outputs of those frames written\n", s.frames, dataset.size(), StopSignal());
   std::printf("tracked %zu/%zu frames (%.1f%%), %zu keyframes, %zu map points, %zu relocalisations, %zu loops closed\n",
               s.tracked, s.frames, 100.0 * s.TrackedFraction(), s.keyframes, s.landmarks, s.relocalizations, s.loops);
   if (s.maps_started > 1 || s.maps_left > 1) {
@@ -193,9 +198,15 @@ void Run(const RunArgs& a) {
                 a.from.rosbag.c_str(), (out / "groundtruth.txt").c_str(), (out / "groundtruth.txt").c_str(),
                 (out / "trajectory.txt").c_str());
   }
+  if (viewer.server && a.viewer_keep && !s.interrupted) {
+    std::printf("viewer: the run has finished; still at %s (Ctrl-C to quit)\n", viewer.server->url().c_str());
+    std::fflush(stdout);
+    const StopSignals signals("\ndetslam: viewer closed\n");
+    signals.Wait();
+  }
   if (s.interrupted) {
     std::fflush(stdout);
-    throw CommandFailed("run interrupted (outputs written for the frames processed)", 128 + static_cast<int>(g_signal));
+    throw CommandFailed("run interrupted (outputs written for the frames processed)", 128 + StopSignal());
   }
 }
 
@@ -238,6 +249,13 @@ void AddRunCommand(CLI::App& app) {
   cmd->add_option("--dense-map", args->dense_map,
                   "After the run, fuse the keyframes at their final poses, without the dynamic objects' pixels, into a TSDF volume and write its surface here (PLY point cloud with colours and normals)");
   AddDenseOptions(cmd, &args->dense);
+  cmd->add_option("--viewer", args->viewer_port,
+                  "Serve a live view of the run on http://127.0.0.1:PORT/ (frame, keypoints, masks, 3-D map, counters; no PORT or 0: a free port, printed)")
+      ->expected(0, 1)
+      ->default_str("0")
+      ->check(CLI::Range(0, 65535));
+  cmd->add_flag("--viewer-keep", args->viewer_keep, "With --viewer: keep serving after the run until Ctrl-C");
+  cmd->add_flag("--paused", args->paused, "With --viewer (sequential): start paused; the page's Step and Resume buttons run it");
   cmd->callback([args] { Run(*args); });
 }
 

@@ -25,5 +25,6 @@ void AddVocabCommand(CLI::App& app);
 void AddMapCommand(CLI::App& app);
 void AddRosbagCommand(CLI::App& app);
 void AddDensifyCommand(CLI::App& app);
+void AddViewCommand(CLI::App& app);
 
 }  // namespace detslam::app

@@ -29,6 +29,7 @@ int main(int argc, char** argv) {
   detslam::app::AddMapCommand(app);
   detslam::app::AddRosbagCommand(app);
   detslam::app::AddDensifyCommand(app);
+  detslam::app::AddViewCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -260,6 +260,27 @@ FrameReport SkippedReport(const RgbdSource& dataset, const LoadedFrame& f) {
   return r;
 }
 
+// Tells the run's observer (if any) about a frame just finished.
+void Observe(RunObserver* observer, const SlamSystem& slam, const FrameReport& report,
+             const cv::Mat* bgr = nullptr, const std::vector<Instance>* instances = nullptr,
+             const Frame* tracked = nullptr) {
+  if (observer == nullptr) return;
+  ObservedFrame f;
+  f.report = &report;
+  f.bgr = bgr;
+  f.instances = instances;
+  f.frame = tracked;
+  observer->OnFrame(f, slam);
+}
+
+RunSummary Finish(RunRecorder& recorder, const RgbdSource& dataset, const Settings& settings,
+                  const RunOptions& options, SlamSystem& slam,
+                  std::chrono::steady_clock::time_point start, const Segmenter* segmenter) {
+  RunSummary summary = recorder.Finish(dataset, settings, options, slam, start, segmenter);
+  if (options.observer) options.observer->OnFinish(summary, slam);
+  return summary;
+}
+
 Frame Extract(const SlamSystem& slam, const RgbdSource& dataset, const LoadedFrame& f,
               FrameReport* report) {
   report->segmentation_ms = f.segmentation_ms;
@@ -280,21 +301,32 @@ RunSummary RunSequential(const RgbdSource& dataset, const Settings& settings,
   RunRecorder recorder(n, progress, options);
   recorder.LoadMap(options, &slam);
   const StopWatcher watcher(options, &slam);
+  RunObserver* observer = options.observer;
+  if (observer) observer->OnStart(n, /*pausable=*/true);
   for (size_t i = 0; i < n && !StopRequested(options); ++i) {
+    if (observer) {
+      observer->WaitBeforeFrame(static_cast<int64_t>(i), slam);
+      if (StopRequested(options)) break;
+    }
     const LoadedFrame loaded = LoadAndSegment(dataset, settings, i, &slam);
     if (!loaded.unreadable.empty()) {
-      recorder.AddSkipped(SkippedReport(dataset, loaded));
+      const FrameReport report = SkippedReport(dataset, loaded);
+      recorder.AddSkipped(report);
+      Observe(observer, slam, report);
       continue;
     }
     FrameReport report;
     Frame frame = Extract(slam, dataset, loaded, &report);
-    const KeyFrameId kf = slam.TrackFrame(std::move(frame), &report);
+    Frame tracked;
+    const KeyFrameId kf = slam.TrackFrame(std::move(frame), &report, observer ? &tracked : nullptr);
     recorder.AddFrameMasks(options, loaded.index, kf != kNoKeyFrame, loaded.instances,
                            loaded.images.depth_m);
     if (kf != kNoKeyFrame) slam.MapKeyFrame(kf, &report);
     recorder.Add(report);
+    Observe(observer, slam, report, &loaded.images.bgr, loaded.segmented ? &loaded.instances : nullptr,
+            &tracked);
   }
-  return recorder.Finish(dataset, settings, options, slam, start, segmenter);
+  return Finish(recorder, dataset, settings, options, slam, start, segmenter);
 }
 
 RunSummary RunThreaded(const RgbdSource& dataset, const Settings& settings,
@@ -312,8 +344,12 @@ RunSummary RunThreaded(const RgbdSource& dataset, const Settings& settings,
     Frame frame;
     FrameReport report;
     std::vector<Instance> instances;  // for the keyframe masks
+    bool segmented = false;
     cv::Mat depth_m;
+    cv::Mat bgr;  // for the observer (only with one)
   };
+  RunObserver* observer = options.observer;
+  if (observer) observer->OnStart(n, /*pausable=*/false);
   BoundedQueue<LoadedFrame> loaded(options.queue_capacity);
   BoundedQueue<Extracted> extracted(options.queue_capacity);
   BoundedQueue<KeyFrameId> keyframes(8);
@@ -344,7 +380,9 @@ RunSummary RunThreaded(const RgbdSource& dataset, const Settings& settings,
           } else {
             e.frame = Extract(slam, dataset, *f, &e.report);
             e.instances = std::move(f->instances);
+            e.segmented = f->segmented;
             e.depth_m = f->images.depth_m;
+            if (observer) e.bgr = f->images.bgr;
           }
           if (!extracted.Push(std::move(e))) break;
         }
@@ -366,9 +404,12 @@ RunSummary RunThreaded(const RgbdSource& dataset, const Settings& settings,
           if (StopRequested(options)) break;
           if (!e->report.skipped.empty()) {
             recorder.AddSkipped(e->report);
+            Observe(observer, slam, e->report);
             continue;
           }
-          const KeyFrameId kf = slam.TrackFrame(std::move(e->frame), &e->report);
+          Frame tracked;
+          const KeyFrameId kf =
+              slam.TrackFrame(std::move(e->frame), &e->report, observer ? &tracked : nullptr);
           recorder.AddFrameMasks(options, e->report.index, kf != kNoKeyFrame, e->instances,
                                  e->depth_m);
           if (kf != kNoKeyFrame) {
@@ -379,11 +420,13 @@ RunSummary RunThreaded(const RgbdSource& dataset, const Settings& settings,
             }
           }
           recorder.Add(e->report);
+          Observe(observer, slam, e->report, &e->bgr, e->segmented ? &e->instances : nullptr,
+                  &tracked);
         }
       },
       [&] { keyframes.Close(); });
   stages.Join();
-  return recorder.Finish(dataset, settings, options, slam, start, segmenter);
+  return Finish(recorder, dataset, settings, options, slam, start, segmenter);
 }
 
 RunSummary Run(const RgbdSource& dataset, const Settings& settings, const RunOptions& options,

@@ -13,6 +13,7 @@
 #include "detslam/dense/dense_fusion.h"
 #include "detslam/io/dataset.h"
 #include "detslam/io/settings.h"
+#include "detslam/pipeline/run_observer.h"
 #include "detslam/pipeline/slam_system.h"
 #include "detslam/segmentation/segmenter.h"
 
@@ -39,6 +40,9 @@ struct RunOptions {
   // frames still queued are dropped, a running global BA stops after its current iteration, and
   // the outputs of the frames processed so far are written (RunSummary::interrupted).
   const std::atomic<bool>* stop = nullptr;
+  // Told about every frame (e.g. the live viewer; may be null). In sequential mode it may hold the
+  // run before each frame (pause, step).
+  RunObserver* observer = nullptr;
   SlamOptions slam;
 };
 

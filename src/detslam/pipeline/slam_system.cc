@@ -258,7 +258,7 @@ Frame SlamSystem::ExtractFrame(int64_t index, Timestamp stamp, const cv::Mat& gr
   return frame;
 }
 
-KeyFrameId SlamSystem::TrackFrame(Frame frame, FrameReport* report) {
+KeyFrameId SlamSystem::TrackFrame(Frame frame, FrameReport* report, Frame* tracked) {
   auto t0 = std::chrono::steady_clock::now();
   const MapStore::WriteAccess access = store_.Write();
   Map& map = *access;
@@ -282,6 +282,7 @@ KeyFrameId SlamSystem::TrackFrame(Frame frame, FrameReport* report) {
   report->keyframe = new_kf != kNoKeyFrame;
   report->map_keyframes = static_cast<int>(map.NumKeyFrames());
   report->map_points = static_cast<int>(map.NumLandmarks());
+  if (tracked != nullptr) *tracked = std::move(frame);
   return new_kf;
 }
 

@@ -135,8 +135,10 @@ class SlamSystem {
                      const cv::Mat& ignore_mask, FrameReport* report,
                      const std::vector<Instance>* instances = nullptr) const;
   // Tracking stage: tracks an extracted frame (input order) and makes it a keyframe when the
-  // tracker asks for one. Returns the new keyframe for MapKeyFrame, or kNoKeyFrame.
-  KeyFrameId TrackFrame(Frame frame, FrameReport* report);
+  // tracker asks for one. Returns the new keyframe for MapKeyFrame, or kNoKeyFrame. With
+  // `tracked`, the frame as tracked (its keypoints' landmarks, outliers and labels) is moved there
+  // (for a viewer).
+  KeyFrameId TrackFrame(Frame frame, FrameReport* report, Frame* tracked = nullptr);
   // Local mapping stage: local mapping and loop closing of a keyframe from TrackFrame. Fills
   // report->timings.mapping_ms and loop_closed.
   void MapKeyFrame(KeyFrameId kf, FrameReport* report);
