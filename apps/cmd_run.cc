@@ -198,6 +198,12 @@ void Run(const RunArgs& a) {
                 a.from.rosbag.c_str(), (out / "groundtruth.txt").c_str(), (out / "groundtruth.txt").c_str(),
                 (out / "trajectory.txt").c_str());
   }
+  if (viewer.content) {
+    const LiveViewer::Cost c = viewer.content->cost();
+    std::printf("viewer cost: %.3f ms per frame in the tracking thread (max %.1f), %llu map snapshots of %.2f ms (max %.1f)\n",
+                c.on_frame_ms_mean, c.on_frame_ms_max, static_cast<unsigned long long>(c.map_snapshots),
+                c.map_snapshot_ms_mean, c.map_snapshot_ms_max);
+  }
   if (viewer.server && a.viewer_keep && !s.interrupted) {
     std::printf("viewer: the run has finished; still at %s (Ctrl-C to quit)\n", viewer.server->url().c_str());
     std::fflush(stdout);

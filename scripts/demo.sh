@@ -47,3 +47,5 @@ echo "Outputs under $OUT/: <run>/trajectory.txt (TUM), keyframes.txt, map.ply, r
 echo "eval.json, eval.svg (trajectory and error plots) and report.html (the run with its plots;"
 echo "open it in a browser); people_detslam_$FILTER/dense_map.ply is the dense static map with the"
 echo "people removed (open it in MeshLab or CloudCompare)."
+echo "Look at a run in the browser: $DETSLAM view $OUT/people_detslam_$FILTER (Ctrl-C to quit), or"
+echo "watch one live: $DETSLAM run --dataset $OUT/walking_xyz --segmenter $FILTER --out $OUT/live --viewer"

@@ -1,5 +1,6 @@
 #include "detslam/viewer/live_viewer.h"
 
+#include <algorithm>
 #include <unordered_set>
 
 #include "detslam/pipeline/runner.h"
@@ -117,6 +118,7 @@ void LiveViewer::WaitBeforeFrame(int64_t /*index*/, const SlamSystem& slam) {
 }
 
 void LiveViewer::OnFrame(const ObservedFrame& observed, const SlamSystem& slam) {
+  const auto start = std::chrono::steady_clock::now();
   std::shared_ptr<ViewerFrame> frame = MakeViewerFrame(observed);
   const FrameReport& r = *observed.report;
   const auto now = std::chrono::steady_clock::now();
@@ -125,6 +127,7 @@ void LiveViewer::OnFrame(const ObservedFrame& observed, const SlamSystem& slam) 
     std::lock_guard<std::mutex> lock(mutex_);
     ViewerCounters& c = counters_;
     c.frame = r.index;
+    c.state = r.skipped.empty() ? ToString(r.tracking.state) : "skipped";
     ++c.frames_done;
     if (r.tracking.pose_valid) ++c.tracked;
     if (r.tracking.relocalized) ++c.relocalizations;
@@ -149,6 +152,23 @@ void LiveViewer::OnFrame(const ObservedFrame& observed, const SlamSystem& slam) 
     Publish();
   }
   if (map_due && Watched()) TakeMapSnapshot(slam, current_map_);
+  const double ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  std::lock_guard<std::mutex> lock(mutex_);
+  on_frame_ms_sum_ += ms;  // map snapshots included
+  on_frame_ms_max_ = std::max(on_frame_ms_max_, ms);
+}
+
+LiveViewer::Cost LiveViewer::cost() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  Cost c;
+  c.frames = static_cast<uint64_t>(counters_.frames_done);
+  c.on_frame_ms_mean = c.frames ? on_frame_ms_sum_ / c.frames : 0.0;
+  c.on_frame_ms_max = on_frame_ms_max_;
+  c.map_snapshots = map_snapshots_.load();
+  c.map_snapshot_ms_mean = c.map_snapshots ? snapshot_ms_sum_ / c.map_snapshots : 0.0;
+  c.map_snapshot_ms_max = snapshot_ms_max_;
+  return c;
 }
 
 void LiveViewer::OnFinish(const RunSummary& summary, const SlamSystem& slam) {
@@ -168,6 +188,7 @@ void LiveViewer::OnFinish(const RunSummary& summary, const SlamSystem& slam) {
 }
 
 void LiveViewer::TakeMapSnapshot(const SlamSystem& slam, int map_id) {
+  const auto start = std::chrono::steady_clock::now();
   auto m = std::make_shared<ViewerMap>();
   const MapTrajectories trajectories = slam.FrameTrajectories();
   if (map_id < 0) map_id = trajectories.main_map;
@@ -197,6 +218,9 @@ void LiveViewer::TakeMapSnapshot(const SlamSystem& slam, int map_id) {
   map_ = std::move(m);
   last_map_time_ = std::chrono::steady_clock::now();
   ++map_snapshots_;
+  const double ms = std::chrono::duration<double, std::milli>(last_map_time_ - start).count();
+  snapshot_ms_sum_ += ms;
+  snapshot_ms_max_ = std::max(snapshot_ms_max_, ms);
   Publish();
 }
 
@@ -214,7 +238,10 @@ uint64_t LiveViewer::WaitForUpdate(uint64_t seen, std::chrono::milliseconds time
 ViewerCounters LiveViewer::Counters() const {
   last_request_ns_ = SteadyNs();
   std::lock_guard<std::mutex> lock(mutex_);
-  return counters_;
+  ViewerCounters c = counters_;
+  c.pages = clients_.load();
+  c.seq = update_;
+  return c;
 }
 
 std::shared_ptr<const ViewerFrame> LiveViewer::Frame(int64_t index) {

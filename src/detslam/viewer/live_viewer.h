@@ -51,6 +51,15 @@ class LiveViewer : public RunObserver, public ViewerContent {
 
   // Map snapshots taken so far (0 while no page connected: the cost test).
   uint64_t map_snapshots() const { return map_snapshots_.load(); }
+  // The viewer's own cost to the run: time in OnFrame (in the tracking thread) and in map
+  // snapshots (taken in the tracking thread while a page is connected).
+  struct Cost {
+    uint64_t frames = 0;
+    double on_frame_ms_mean = 0, on_frame_ms_max = 0;
+    uint64_t map_snapshots = 0;
+    double map_snapshot_ms_mean = 0, map_snapshot_ms_max = 0;
+  };
+  Cost cost() const;
 
  private:
   bool Watched() const;
@@ -72,6 +81,8 @@ class LiveViewer : public RunObserver, public ViewerContent {
   std::atomic<int> clients_{0};
   mutable std::atomic<int64_t> last_request_ns_{0};  // steady clock of the last page request
   std::atomic<uint64_t> map_snapshots_{0};
+  // Cost (under mutex_): sums and maxima in milliseconds.
+  double on_frame_ms_sum_ = 0, on_frame_ms_max_ = 0, snapshot_ms_sum_ = 0, snapshot_ms_max_ = 0;
 };
 
 }  // namespace detslam

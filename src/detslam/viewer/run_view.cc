@@ -23,6 +23,7 @@ RunView::RunView(RunViewInputs inputs) : in_(std::move(inputs)) {
            (log_.segmenter.empty() ? "none" : log_.segmenter) + ", " + log_.mode + ")";
   ViewerCounters& c = counters_;
   c.mode = "run";
+  if (!log_.per_frame.empty()) c.state = log_.per_frame.back().state;  // after the last frame
   c.frames_done = log_.frames;
   c.total = log_.per_frame.empty() ? log_.frames : static_cast<int64_t>(log_.per_frame.size());
   c.tracked = log_.frames_tracked;

@@ -63,10 +63,15 @@ struct ViewerMap {
 
 struct ViewerCounters {
   std::string mode;  // "live" or "run" (a finished run's folder)
+  std::string state;  // tracking state after the newest frame ("" before the first)
   int64_t frame = -1, frames_done = 0, total = 0, tracked = 0;
   int64_t keyframes = 0, points = 0, loops = 0, merges = 0, maps = 0, relocalizations = 0;
   double fps = 0;
   bool pausable = false, paused = false, finished = false;
+  int pages = 0;  // pages connected to the update stream
+  // Update number these counters were read at: a page keeps the newest of the stream's and a
+  // control request's replies, which can arrive in either order.
+  uint64_t seq = 0;
 };
 
 class ViewerContent {

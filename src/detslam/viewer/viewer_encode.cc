@@ -52,6 +52,7 @@ void AppendPositions(std::string* out, const std::vector<Eigen::Vector3d>& p) {
 
 std::string CountersJson(const ViewerCounters& c) {
   nlohmann::json j = {{"mode", c.mode},
+                      {"state", c.state},
                       {"frame", c.frame},
                       {"frames_done", c.frames_done},
                       {"total", c.total},
@@ -65,7 +66,9 @@ std::string CountersJson(const ViewerCounters& c) {
                       {"fps", std::round(c.fps * 10) / 10},
                       {"pausable", c.pausable},
                       {"paused", c.paused},
-                      {"finished", c.finished}};
+                      {"finished", c.finished},
+                      {"pages", c.pages},
+                      {"seq", c.seq}};
   return j.dump();
 }
 

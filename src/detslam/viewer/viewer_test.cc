@@ -107,6 +107,7 @@ class FakeContent : public ViewerContent {
     return update_;
   }
   ViewerCounters Counters() const override {
+    std::lock_guard<std::mutex> lock(mutex_);
     ViewerCounters c;
     c.mode = "live";
     c.frame = frame_ ? frame_->index : -1;
@@ -119,7 +120,8 @@ class FakeContent : public ViewerContent {
   }
   std::shared_ptr<const ViewerMap> Map() override { return nullptr; }
   bool Control(const std::string& action, std::string* error) override {
-    actions.push_back(action);
+    std::lock_guard<std::mutex> lock(mutex_);
+    actions_.push_back(action);
     *error = "refused";
     return action != "resume";
   }
@@ -132,11 +134,15 @@ class FakeContent : public ViewerContent {
     frame_ = f;
     changed_.notify_all();
   }
-  std::vector<std::string> actions;
+  std::vector<std::string> actions() const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return actions_;
+  }
   std::atomic<int> clients{0};
 
  private:
-  std::mutex mutex_;
+  mutable std::mutex mutex_;  // the server calls from its threads
+  std::vector<std::string> actions_;
   std::condition_variable changed_;
   uint64_t update_ = 0;
   std::shared_ptr<const ViewerFrame> frame_;
@@ -206,7 +212,7 @@ TEST(ViewerServer, ServesThePageAndTheApi) {
   EXPECT_EQ(Status(Get(server.port(), "/api/map")), 200);
   EXPECT_EQ(Status(Post(server.port(), "/api/control", "step\n")), 200);
   EXPECT_EQ(Status(Post(server.port(), "/api/control", "resume")), 409);  // refused by the content
-  EXPECT_EQ(content.actions, (std::vector<std::string>{"step", "resume"}));
+  EXPECT_EQ(content.actions(), (std::vector<std::string>{"step", "resume"}));
 }
 
 TEST(ViewerServer, MalformedRequestsGet4xxAndTheServerGoesOn) {
@@ -228,7 +234,7 @@ TEST(ViewerServer, MalformedRequestsGet4xxAndTheServerGoesOn) {
       port, "POST /api/control HTTP/1.1\r\nContent-Length: abc\r\nConnection: close\r\n\r\nstep"));
   EXPECT_TRUE(bad_length >= 400 && bad_length < 500) << bad_length;
   Exchange(port, std::string(1 << 16, 'A'), std::chrono::milliseconds(500));  // no request line
-  EXPECT_TRUE(content.actions.empty());
+  EXPECT_TRUE(content.actions().empty());
   EXPECT_EQ(Status(Get(port, "/api/frame?index=4")), 200);  // still serving
 }
 
@@ -305,7 +311,9 @@ TEST(LiveViewer, StepRunsOneFrameAtATimeAndResumeRunsOn) {
   std::this_thread::sleep_for(std::chrono::milliseconds(200));
   EXPECT_EQ(passed.load(), 0);
   std::string error;
+  const uint64_t seq_before = viewer.Counters().seq;
   ASSERT_TRUE(viewer.Control("step", &error)) << error;
+  EXPECT_GT(viewer.Counters().seq, seq_before);  // the page keeps the newest counters by this
   std::this_thread::sleep_for(std::chrono::milliseconds(200));
   EXPECT_EQ(passed.load(), 1);
   ASSERT_TRUE(viewer.Control("step", &error));

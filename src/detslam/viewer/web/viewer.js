@@ -26,12 +26,14 @@ function noteError(e) {
 
 // ---------------------------------------------------------------- counters and buttons
 function showCounters(c) {
+  // A control request's reply can arrive after a newer update from the stream: keep the newest.
+  if (page.counters && c.seq < page.counters.seq) return;
   page.counters = c;
   page.finished = c.finished;
   const tracked = c.frames_done > 0 ? (100 * c.tracked / c.frames_done).toFixed(1) : '0.0';
   const items = [
     ['frame', (c.frame >= 0 ? c.frame : '-') + ' / ' + c.total],
-    ['fps', c.mode === 'live' ? c.fps.toFixed(1) : '-'],
+    ['fps', c.mode === 'live' ? c.fps.toFixed(1) : '-'], ['state', c.state || '-'],
     ['tracked', tracked + ' %'], ['keyframes', c.keyframes], ['map points', c.points],
     ['loops', c.loops], ['maps', c.maps + (c.merges ? ' (' + c.merges + ' merged)' : '')],
     ['relocalisations', c.relocalizations]
@@ -62,7 +64,9 @@ $('resume').onclick = () => control('resume');
 
 // ---------------------------------------------------------------- the frame panel
 const frameCanvas = $('frame');
-const frameCtx = frameCanvas.getContext('2d');
+// A software canvas (willReadFrequently): without a GPU, Chromium's accelerated 2-D canvas goes through
+// software WebGL, which costs several times more CPU for the image and a thousand keypoint circles.
+const frameCtx = frameCanvas.getContext('2d', { willReadFrequently: true });
 let pendingFrame = null;   // newest frame state not drawn yet
 let imageLoading = false;
 let latestPose = null;     // pose of the newest frame (camera in the 3-D view)
@@ -147,7 +151,9 @@ function initThree() {
   page.three_js = true;
   const canvas = $('map3d');
   try {
-    view.renderer = new THREE.WebGLRenderer({ canvas: canvas, antialias: true,
+    // No antialiasing: points and lines do not need it, and without a GPU (software WebGL) it
+    // multiplies the drawing cost, on the cores the run needs.
+    view.renderer = new THREE.WebGLRenderer({ canvas: canvas, antialias: false,
                                               preserveDrawingBuffer: true });
   } catch (e) {
     $('map-info').textContent = 'WebGL is not available in this browser: no 3-D view';
@@ -197,12 +203,21 @@ function resize3d() {
   render3d();
 }
 
-let renderQueued = false;
-function render3d() {
+// Redraws on the next animation frame; a redraw for a live update (the camera moved on) waits
+// until kLiveRedrawMs after the last one, so the 3-D view costs the same at any frame rate.
+const kLiveRedrawMs = 200;
+let renderQueued = false, lastRender = 0, liveTimer = null;
+function render3d(live) {
   if (!view.renderer || renderQueued) return;
+  const wait = lastRender + kLiveRedrawMs - performance.now();
+  if (live && wait > 0) {
+    if (!liveTimer) liveTimer = setTimeout(() => { liveTimer = null; render3d(); }, wait);
+    return;
+  }
   renderQueued = true;
   requestAnimationFrame(() => {
     renderQueued = false;
+    lastRender = performance.now();
     const c = Math.cos(view.pitch);
     // Orbit around the target; "up" is -y, so the eye sits at negative y above the scene.
     view.camera.position.set(view.target.x + view.dist * c * Math.sin(view.yaw),
@@ -252,7 +267,7 @@ function addLivePose(pose) {
   if (!view.scene) return;
   replace('live', lineOf(view.live, 0x2ecc40));
   replace('camera', frustums([pose], 0xff3030, 0.15));
-  render3d();
+  render3d(/*live=*/true);
 }
 
 // Frames the map points (5-95 % on each axis, so stray points do not count) and the whole
