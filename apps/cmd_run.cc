@@ -37,6 +37,7 @@ struct RunArgs {
   std::string load_map;
   bool localization = false;
   bool threaded = false;
+  bool realtime = false;  // --realtime: frames offered at their timestamps (implies threaded)
   bool inline_mapping = false;
   std::string segmenter;  // empty: dnn if the models are found, else none
   std::string models;
@@ -70,7 +71,7 @@ Viewer StartViewer(const RunArgs& a, const RgbdSource& dataset, const std::strin
   if (a.threaded && a.paused) throw InputError("--paused needs a sequential run (no --threaded)");
   LiveViewerOptions vo;
   vo.title = dataset.name() + " (segmenter " + segmenter + ", " +
-             (a.threaded ? "threaded" : "sequential") + ")";
+             (a.realtime ? "camera rate" : a.threaded ? "threaded" : "sequential") + ")";
   if (!dataset.groundtruth_path().empty()) {
     try {
       vo.ground_truth = ReadTumTrajectory(dataset.groundtruth_path());
@@ -115,8 +116,9 @@ class ProgressBar {
   bool tty_;
 };
 
-void Run(const RunArgs& a) {
+void Run(RunArgs a) {
   namespace fs = std::filesystem;
+  if (a.realtime) a.threaded = true;
   OpenedSource opened = OpenSource(a.from);
   const std::unique_ptr<RgbdSource> source = std::move(opened.source);
   Settings settings = std::move(opened.settings);
@@ -132,6 +134,7 @@ void Run(const RunArgs& a) {
   options.dense_map = a.dense_map;
   options.dense = a.dense;
   options.threaded = a.threaded;
+  options.realtime = a.realtime;
   options.slam = SlamOptionsFromSettings(settings, a.seed);
   options.mapping_thread = a.threaded && !a.inline_mapping;
   if (a.alpha >= 0) options.slam.dynamic.filter.alpha = a.alpha;
@@ -159,7 +162,8 @@ void Run(const RunArgs& a) {
   } else {
     segmenter = MakeSegmenter(spec, dataset.name(), resolved.segmenter, models_dir);
   }
-  std::printf("detslam run (%s, segmenter %s): %zu frames from %s (settings: %s)\n", a.threaded ? "threaded" : "sequential", spec.c_str(), dataset.size(), dataset.name().c_str(),
+  std::printf("detslam run (%s, segmenter %s): %zu frames from %s (settings: %s)\n",
+              a.realtime ? "camera rate" : a.threaded ? "threaded" : "sequential", spec.c_str(), dataset.size(), dataset.name().c_str(),
               settings.source.c_str());
   if (a.paused && a.viewer_port < 0) throw InputError("--paused needs --viewer");
   const Viewer viewer = StartViewer(a, dataset, spec);
@@ -180,6 +184,12 @@ void Run(const RunArgs& a) {
     std::printf("maps: %d started (tracking lost, relocalisation failed), %d merged, %d left; trajectory.txt holds %zu frames%s\n",
                 s.maps_started, s.maps_merged, s.maps_left, s.tracked_main,
                 s.maps_left > 1 ? " (the other maps: trajectory_map<N>.txt, each in its own frame)" : "");
+  }
+  if (a.realtime) {
+    std::printf("camera rate: %zu frames offered, %zu dropped (%.1f%%) because the pipeline was busy, %.1f frames/s processed; "
+                "latency from arrival to pose: median %.1f ms, 99th percentile %.1f ms\n",
+                s.offered, s.dropped_frames.size(), s.offered ? 100.0 * s.dropped_frames.size() / s.offered : 0.0,
+                s.wall_s > 0 ? s.frames / s.wall_s : 0.0, s.latency.median, s.latency_p99_ms);
   }
   if (!s.segmenter.empty()) std::printf("segmentation (%s): median %.1f ms per frame\n", s.segmenter.c_str(), s.segmentation.median);
   std::printf("median ms per frame: extraction %.1f, tracking %.1f, total %.1f; local mapping %.1f per keyframe\n",
@@ -243,6 +253,8 @@ void AddRunCommand(CLI::App& app) {
                   "the keys: detslam settings --list");
   cmd->add_flag("--threaded", args->threaded,
                 "One thread per stage: loading+segmentation, extraction, tracking, local mapping (real-time use; not bit-reproducible)");
+  cmd->add_flag("--realtime", args->realtime,
+                "Camera rate: offer the frames at their timestamps as a live camera would (implies --threaded); a frame the pipeline has not taken when the next arrives is dropped, never queued; run.json reports the frames dropped and each frame's latency from arrival to pose");
   cmd->add_flag("--inline-mapping", args->inline_mapping,
                 "With --threaded: local mapping in the tracking thread (then the trajectory equals the sequential one)");
   cmd->add_flag("--no-progress", args->no_progress, "No progress bar");

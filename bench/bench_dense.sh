@@ -22,17 +22,14 @@ here="$(cd "$(dirname "$0")" && pwd)"
 root="$(dirname "$here")"
 bin="$(realpath "${1:-$root/build/bin/detslam}")"
 evaluator="$(dirname "$(dirname "$bin")")/bench/dense_eval"
-shared="${DETSLAM_SHARED:-$root/../shared}"
 presets="${PRESETS:-walking_xyz walking_static walking_rpy walking_halfsphere}"
 eval_seeds="${EVAL_SEEDS:-201 202 203}"
 tune_seeds="${TUNE_SEEDS:-1 2 3}"
 frames="${FRAMES:-300}"
 jobs="${JOBS:-2}"
-people="$shared/data/people"
-models="$shared/models"
 [[ -x "$evaluator" ]] || { echo "missing $evaluator (build the bench targets)" >&2; exit 1; }
-[[ -f "$people/person_1.png" ]] || { echo "missing $people (needed for realistic people)" >&2; exit 1; }
-[[ -f "$models/yolox_nano/yolox_nano.onnx" ]] || { echo "missing models in $models" >&2; exit 1; }
+source "$here/bench_lib.sh"  # shellcheck source=bench/bench_lib.sh
+need_people_and_models
 work="$(mktemp -d)"
 trap 'rm -rf "$work"' EXIT
 mkdir -p "$work/rows" "$work/fig"

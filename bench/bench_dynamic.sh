@@ -24,7 +24,6 @@ set -euo pipefail
 here="$(cd "$(dirname "$0")" && pwd)"
 root="$(dirname "$here")"
 bin="$(realpath "${1:-$root/build/bin/detslam}")"
-shared="${DETSLAM_SHARED:-$root/../shared}"
 presets="${PRESETS:-walking_xyz walking_static walking_rpy walking_halfsphere sitting_static}"
 seeds="${SEEDS:-1 2 3}"
 frames="${FRAMES:-300}"
@@ -32,10 +31,8 @@ jobs="${JOBS:-2}"
 ks="${KS:-1 2 3 5}"
 repeats="${REPEATS:-3}"
 spread_presets="${SPREAD_PRESETS:-walking_xyz}"
-people="$shared/data/people"
-models="$shared/models"
-[[ -f "$people/person_1.png" ]] || { echo "missing $people (needed for realistic people)" >&2; exit 1; }
-[[ -f "$models/yolox_nano/yolox_nano.onnx" ]] || { echo "missing models in $models" >&2; exit 1; }
+source "$here/bench_lib.sh"  # shellcheck source=bench/bench_lib.sh
+need_people_and_models
 work="$(mktemp -d)"
 trap 'rm -rf "$work"' EXIT
 export bin models people frames work here spread_presets

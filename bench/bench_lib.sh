@@ -17,3 +17,13 @@ run_eval() {  # dataset_dir out_dir [run options...]: sequential run, seed 42, t
   "$bin" eval --gt "$ds/groundtruth.txt" --est "$o/trajectory.txt" --frames "$ds" \
     --json "$o/eval.json" >/dev/null
 }
+
+# The real people cut-outs and the models from ../shared ($DETSLAM_SHARED overrides): sets people
+# and models (needs root), or exits naming what is missing.
+need_people_and_models() {
+  local shared="${DETSLAM_SHARED:-$root/../shared}"
+  people="$shared/data/people"
+  models="$shared/models"
+  [[ -f "$people/person_1.png" ]] || { echo "missing $people (the people cut-outs)" >&2; exit 1; }
+  [[ -f "$models/yolox_nano/yolox_nano.onnx" ]] || { echo "missing models in $models" >&2; exit 1; }
+}

@@ -20,15 +20,12 @@ set -euo pipefail
 here="$(cd "$(dirname "$0")" && pwd)"
 root="$(dirname "$here")"
 bin="$(realpath "${1:-$root/build/bin/detslam}")"
-shared="${DETSLAM_SHARED:-$root/../shared}"
 seeds="${SEEDS:-201 202}"
 frames="${FRAMES:-300}"
-people="$shared/data/people"
-models="$shared/models"
 chromium="$(command -v chromium-headless-shell || command -v chromium || true)"
 [[ -n "$chromium" ]] || { echo "no chromium-headless-shell (apt-get install chromium-headless-shell)" >&2; exit 1; }
-[[ -f "$people/person_1.png" ]] || { echo "missing $people" >&2; exit 1; }
-[[ -f "$models/yolox_nano/yolox_nano.onnx" ]] || { echo "missing models in $models" >&2; exit 1; }
+source "$here/bench_lib.sh"  # shellcheck source=bench/bench_lib.sh
+need_people_and_models
 work="$(mktemp -d)"
 browser_pid=""
 cleanup() { [[ -n "$browser_pid" ]] && kill "$browser_pid" 2>/dev/null; rm -rf "$work"; }

@@ -6,6 +6,9 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
+#include <thread>
+#include <algorithm>
+#include <chrono>
 
 #include "detslam/core/check.h"
 #include "detslam/eval/evaluate.h"
@@ -131,12 +134,13 @@ TEST(IntegrationSlamDynamic, GroundTruthMasksRemoveThePeople) {
   EXPECT_GT(frames_with_people, 100) << "the filter saw people in too few frames";
 }
 
-// A segmenter that fails on frame `fail_at` (as a model file that cannot be read would).
+// A segmenter that fails from frame `fail_at` on (as a model file that cannot be read would; "from
+// on": at camera rate that frame itself may be dropped).
 class FailingSegmenter : public Segmenter {
  public:
   explicit FailingSegmenter(int64_t fail_at) : fail_at_(fail_at) {}
   std::vector<Instance> Segment(const SegmenterInput& input) override {
-    if (input.index == fail_at_) throw InputError("model.onnx", 0, "segmenter failed on frame " + std::to_string(fail_at_));
+    if (input.index >= fail_at_) throw InputError("model.onnx", 0, "segmenter failed on frame " + std::to_string(fail_at_));
     return {};
   }
   std::string name() const override { return "failing"; }
@@ -151,21 +155,86 @@ TEST(IntegrationRunner, AFailingStageEndsTheRunWithItsMessage) {
   const std::string seq = WriteStaticSequence("failing_stage", 1, 40);
   const RgbdDataset dataset = RgbdDataset::Open(seq, {});
   const Settings settings = PresetForDataset(seq);
-  for (const auto& [threaded, mapping_thread] : {std::pair{false, false}, {true, false}, {true, true}}) {
+  struct Mode {
+    bool threaded, mapping_thread, realtime;
+  };
+  for (const auto& [threaded, mapping_thread, realtime] :
+       {Mode{false, false, false}, {true, false, false}, {true, true, false}, {true, true, true}}) {
     RunOptions options;
     options.out_dir = TempDir("failing_stage_run");
     options.threaded = threaded;
     options.mapping_thread = mapping_thread;
+    options.realtime = realtime;
     options.slam = SlamOptionsFromSettings(settings, 42);
     FailingSegmenter segmenter(25);
     try {
       detslam::Run(dataset, settings, options, nullptr, &segmenter);
-      ADD_FAILURE() << "no error (threaded " << threaded << ", mapping thread " << mapping_thread << ")";
+      ADD_FAILURE() << "no error (threaded " << threaded << ", mapping thread " << mapping_thread
+                    << ", camera rate " << realtime << ")";
     } catch (const InputError& e) {
       EXPECT_NE(std::string(e.what()).find("segmenter failed on frame 25"), std::string::npos) << e.what();
     }
     EXPECT_FALSE(fs::exists(fs::path(options.out_dir) / "trajectory.txt"));
   }
+}
+
+// A segmenter that takes `ms` per frame.
+class SlowSegmenter : public Segmenter {
+ public:
+  explicit SlowSegmenter(int ms) : ms_(ms) {}
+  std::vector<Instance> Segment(const SegmenterInput&) override {
+    std::this_thread::sleep_for(std::chrono::milliseconds(ms_));
+    return {};
+  }
+  std::string name() const override { return "slow"; }
+
+ private:
+  int ms_;
+};
+
+// Camera rate (--realtime): 60 frames of a 30 fps sequence are offered over 2 s; a segmenter that
+// takes 100 ms per frame lets through about one frame in three, the others are dropped at the
+// camera, not queued: every frame is either processed or dropped, the processed ones in order,
+// and latency stays bounded (queued frames would wait up to 4 s by the end).
+TEST(IntegrationRunner, CameraRateDropsTheFramesThePipelineCannotTake) {
+  const std::string seq = WriteStaticSequence("camera_rate", 1, 60);
+  const RgbdDataset dataset = RgbdDataset::Open(seq, {});
+  const Settings settings = PresetForDataset(seq);
+  RunOptions options;
+  options.out_dir = TempDir("camera_rate_run");
+  options.threaded = true;
+  options.mapping_thread = true;
+  options.realtime = true;
+  options.slam = SlamOptionsFromSettings(settings, 42);
+  SlowSegmenter segmenter(100);
+  const RunSummary s = detslam::Run(dataset, settings, options, nullptr, &segmenter);
+  EXPECT_EQ(s.offered, 60u);
+  EXPECT_EQ(s.frames + s.dropped_frames.size(), 60u);
+  EXPECT_GE(s.dropped_frames.size(), 30u) << "frames were queued, not dropped";
+  EXPECT_GE(s.wall_s, 1.9) << "frames were not offered at the camera's rate";
+  std::vector<int64_t> all = s.dropped_frames;
+  int64_t previous = -1;
+  for (const FrameReport& r : s.reports) {
+    EXPECT_GT(r.index, previous) << "processed out of order";
+    previous = r.index;
+    all.push_back(r.index);
+    EXPECT_GE(r.latency_ms, 100.0) << "frame " << r.index << ": latency shorter than its segmentation";
+    EXPECT_LT(r.latency_ms, 2000.0) << "frame " << r.index << " waited in a queue";
+  }
+  std::sort(all.begin(), all.end());
+  for (int64_t i = 0; i < 60; ++i) {
+    ASSERT_LT(static_cast<size_t>(i), all.size());
+    EXPECT_EQ(all[static_cast<size_t>(i)], i) << "a frame neither processed nor dropped, or both";
+  }
+  EXPECT_EQ(s.latency.count, s.frames);
+  EXPECT_GE(s.latency_p99_ms, s.latency.median);
+  const nlohmann::json j = nlohmann::json::parse(ReadFile((fs::path(options.out_dir) / "run.json").string()));
+  EXPECT_EQ(j["mode"], "camera rate (mapping thread)");
+  EXPECT_EQ(j["realtime"]["dropped"].get<size_t>(), s.dropped_frames.size());
+  EXPECT_TRUE(j["per_frame"][0].contains("latency_ms"));
+  const RunLog log = ReadRunLog((fs::path(options.out_dir) / "run.json").string());
+  EXPECT_EQ(log.realtime.offered, 60);
+  EXPECT_EQ(log.realtime.dropped, static_cast<int64_t>(s.dropped_frames.size()));
 }
 
 TEST(IntegrationSlamSynthetic, StaticPresetTracksEveryFrameWithinOneCentimetre) {

@@ -29,6 +29,15 @@ ErrorStats ComputeErrorStats(const std::vector<double>& values) {
   return s;
 }
 
+double Percentile(std::vector<double> values, double p) {
+  if (values.empty()) return 0.0;
+  std::sort(values.begin(), values.end());
+  const double rank = std::clamp(p, 0.0, 100.0) / 100.0 * static_cast<double>(values.size() - 1);
+  const size_t lo = static_cast<size_t>(std::floor(rank));
+  const size_t hi = std::min(lo + 1, values.size() - 1);
+  return values[lo] + (rank - static_cast<double>(lo)) * (values[hi] - values[lo]);
+}
+
 ErrorStats ScaleErrorStats(const ErrorStats& stats, double factor) {
   ErrorStats s = stats;
   s.rmse *= factor;

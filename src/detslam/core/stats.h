@@ -21,6 +21,10 @@ struct ErrorStats {
 
 ErrorStats ComputeErrorStats(const std::vector<double>& values);
 
+// The p-th percentile (0 <= p <= 100) with linear interpolation between the two nearest ranks,
+// as numpy.percentile does by default; 0 for no values.
+double Percentile(std::vector<double> values, double p);
+
 // Every value field multiplied by `factor` (count unchanged), e.g. to convert units.
 ErrorStats ScaleErrorStats(const ErrorStats& stats, double factor);
 

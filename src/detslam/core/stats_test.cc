@@ -35,5 +35,16 @@ TEST(ErrorStats, EmptyAndScaled) {
   EXPECT_DOUBLE_EQ(s.std, 0.5);
 }
 
+TEST(Percentile, InterpolatesBetweenRanksLikeNumpy) {
+  // numpy.percentile([1, 2, 3, 4], q) for q = 0, 50, 99, 100: 1, 2.5, 3.97, 4.
+  const std::vector<double> v = {4, 1, 3, 2};
+  EXPECT_DOUBLE_EQ(Percentile(v, 0), 1.0);
+  EXPECT_DOUBLE_EQ(Percentile(v, 50), 2.5);
+  EXPECT_NEAR(Percentile(v, 99), 3.97, 1e-12);
+  EXPECT_DOUBLE_EQ(Percentile(v, 100), 4.0);
+  EXPECT_DOUBLE_EQ(Percentile({7}, 99), 7.0);
+  EXPECT_EQ(Percentile({}, 50), 0.0);
+}
+
 }  // namespace
 }  // namespace detslam

@@ -65,6 +65,16 @@ RunLog ReadRunLog(const std::string& path) {
     if (!merges.is_array()) throw InputError(path, 0, "key 'maps.merges' must be an array");
     for (const json& x : merges) r.maps.merge_frames.push_back(Get<int64_t>(x, "frame", path, "maps.merges: "));
   }
+  if (j.contains("realtime")) {  // camera-rate runs only
+    const json& t = j["realtime"];
+    r.realtime.offered = Get<int64_t>(t, "offered", path, "realtime: ");
+    r.realtime.dropped = Get<int64_t>(t, "dropped", path, "realtime: ");
+    r.realtime.processed_fps = Get<double>(t, "processed_fps", path, "realtime: ");
+    const json latency = Get<json>(t, "latency_ms", path, "realtime: ");
+    r.realtime.latency_median_ms = Get<double>(latency, "median", path, "realtime.latency_ms: ");
+    r.realtime.latency_p99_ms = Get<double>(latency, "p99", path, "realtime.latency_ms: ");
+    r.realtime.latency_max_ms = Get<double>(latency, "max", path, "realtime.latency_ms: ");
+  }
   const json frames = Get<json>(j, "per_frame", path, "");
   if (!frames.is_array()) throw InputError(path, 0, "key 'per_frame' must be an array");
   for (size_t k = 0; k < frames.size(); ++k) {

@@ -37,6 +37,13 @@ struct RunMapsLog {
   std::vector<int64_t> merge_frames;      // input frame of each merge
 };
 
+// Camera-rate mode (run.json "realtime"; absent for other runs: offered 0).
+struct RunRealtimeLog {
+  int64_t offered = 0, dropped = 0;
+  double processed_fps = 0;
+  double latency_median_ms = 0, latency_p99_ms = 0, latency_max_ms = 0;
+};
+
 struct RunLog {
   std::string path;  // the run.json read
   std::string dataset, settings, mode, segmenter;
@@ -44,6 +51,7 @@ struct RunLog {
   int64_t relocalizations = 0, loops_closed = 0;
   double wall_s = 0;
   RunMapsLog maps;
+  RunRealtimeLog realtime;
   std::vector<RunFrameLog> per_frame;
 
   double TrackedFraction() const {

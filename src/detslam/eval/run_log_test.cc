@@ -123,6 +123,24 @@ TEST_F(RunLogTest, ReadsTheMapsOfTheAtlasWhereTheRunWroteThem) {
   EXPECT_THAT(Error(Write(text)), HasSubstr("maps: key 'started' has the wrong type"));
 }
 
+TEST_F(RunLogTest, ReadsTheCameraRateBlockOfRealtimeRuns) {
+  EXPECT_EQ(ReadRunLog(Write(RunJson(kFrame))).realtime.offered, 0);  // not a camera-rate run
+  std::string text = RunJson(kFrame);
+  text.replace(text.find("\"per_frame\""), 0,
+               R"("realtime": {"offered": 300, "dropped": 201, "dropped_fraction": 0.67,
+               "dropped_frames": [1, 2], "processed_fps": 9.5, "latency_ms": {"median": 150.5,
+               "mean": 160, "p99": 270.25, "max": 300}}, )");
+  const RunLog r = ReadRunLog(Write(text));
+  EXPECT_EQ(r.realtime.offered, 300);
+  EXPECT_EQ(r.realtime.dropped, 201);
+  EXPECT_DOUBLE_EQ(r.realtime.processed_fps, 9.5);
+  EXPECT_DOUBLE_EQ(r.realtime.latency_median_ms, 150.5);
+  EXPECT_DOUBLE_EQ(r.realtime.latency_p99_ms, 270.25);
+  EXPECT_DOUBLE_EQ(r.realtime.latency_max_ms, 300.0);
+  text.replace(text.find("\"p99\": 270.25"), 13, "\"p99\": null");
+  EXPECT_THAT(Error(Write(text)), HasSubstr("realtime.latency_ms: key 'p99' has the wrong type"));
+}
+
 TEST_F(RunLogTest, BadInputNamesTheFileLineAndKey) {
   EXPECT_THAT(Error((dir_ / "missing.json").string()), HasSubstr("cannot open run log"));
   // A syntax error on line 3.

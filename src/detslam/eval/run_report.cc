@@ -272,6 +272,17 @@ std::string RenderHtmlReport(const RunLog& run, const EvalResult* eval) {
                  std::to_string(run.relocalizations) + " / " + std::to_string(run.loops_closed))
      << TableRow("wall time",
                  Fixed(run.wall_s, 1) + " s (" + Fixed(run.FramesPerSecond(), 1) + " frames/s)");
+  if (run.realtime.offered > 0) {
+    const RunRealtimeLog& t = run.realtime;
+    os << TableRow("camera rate",
+                   std::to_string(t.offered) + " frames offered, " + std::to_string(t.dropped) +
+                       " dropped (" + Fixed(100.0 * t.dropped / t.offered, 1) +
+                       " %) because the pipeline was busy; " + Fixed(t.processed_fps, 1) +
+                       " frames/s processed; latency from arrival to pose: median " +
+                       Fixed(t.latency_median_ms, 1) + " ms, 99th percentile " +
+                       Fixed(t.latency_p99_ms, 1) + " ms, max " + Fixed(t.latency_max_ms, 1) +
+                       " ms");
+  }
   const ErrorStats s = ComputeErrorStats(seg), e = ComputeErrorStats(ext),
                    t = ComputeErrorStats(trk);
   os << TableRow("median ms per frame",

@@ -109,6 +109,20 @@ TEST(RunReport, HtmlWithoutGroundTruthSummarisesTheRun) {
   EXPECT_THAT(html, HasSubstr("(a) Tracking"));
   EXPECT_THAT(html, HasSubstr("</html>"));
   EXPECT_EQ(html.find("<script"), std::string::npos);
+  EXPECT_THAT(html, Not(HasSubstr("camera rate")));  // not a --realtime run
+}
+
+TEST(RunReport, ACameraRateRunShowsItsDropsAndLatency) {
+  RunLog log = HandLog();
+  log.realtime.offered = 60;
+  log.realtime.dropped = 40;
+  log.realtime.processed_fps = 10;
+  log.realtime.latency_median_ms = 150;
+  log.realtime.latency_p99_ms = 270.5;
+  log.realtime.latency_max_ms = 300;
+  const std::string html = RenderHtmlReport(log, nullptr);
+  EXPECT_THAT(html, HasSubstr("60 frames offered, 40 dropped (66.7 %)"));
+  EXPECT_THAT(html, HasSubstr("median 150.0 ms, 99th percentile 270.5 ms, max 300.0 ms"));
 }
 
 TEST(RunReport, HtmlWithEvaluationEmbedsTheAccuracyFigure) {

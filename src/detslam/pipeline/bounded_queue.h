@@ -26,6 +26,21 @@ class BoundedQueue {
     return true;
   }
 
+  // Never blocks: when the queue is full its oldest item makes room and is handed to *dropped
+  // (a camera's newest-frame buffer). Returns false if the queue was closed (the item is dropped).
+  bool PushDroppingOldest(T item, std::optional<T>* dropped) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    dropped->reset();
+    if (closed_) return false;
+    if (items_.size() >= capacity_) {
+      *dropped = std::move(items_.front());
+      items_.pop_front();
+    }
+    items_.push_back(std::move(item));
+    not_empty_.notify_one();
+    return true;
+  }
+
   // Next item, or nullopt once the queue is closed and empty.
   std::optional<T> Pop() {
     std::unique_lock<std::mutex> lock(mutex_);

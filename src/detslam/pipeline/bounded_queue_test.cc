@@ -40,5 +40,21 @@ TEST(BoundedQueue, CloseWakesABlockedProducer) {
   EXPECT_FALSE(result);
 }
 
+TEST(BoundedQueue, PushDroppingOldestNeverBlocksAndHandsBackTheOldest) {
+  BoundedQueue<int> q(1);
+  std::optional<int> dropped;
+  ASSERT_TRUE(q.PushDroppingOldest(1, &dropped));
+  EXPECT_EQ(dropped, std::nullopt);
+  ASSERT_TRUE(q.PushDroppingOldest(2, &dropped));  // full: 1 makes room
+  EXPECT_EQ(dropped, std::optional<int>(1));
+  EXPECT_EQ(q.Pop(), std::optional<int>(2));
+  ASSERT_TRUE(q.PushDroppingOldest(3, &dropped));
+  EXPECT_EQ(dropped, std::nullopt);
+  q.Close();
+  EXPECT_FALSE(q.PushDroppingOldest(4, &dropped));
+  EXPECT_EQ(q.Pop(), std::optional<int>(3));
+  EXPECT_EQ(q.Pop(), std::nullopt);
+}
+
 }  // namespace
 }  // namespace detslam

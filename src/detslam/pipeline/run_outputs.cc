@@ -103,8 +103,11 @@ void WriteRunOutputs(const RgbdSource& dataset, const Settings& settings, const 
   j["dataset"] = dataset.name();
   j["settings"] = settings.source;
   j["effective_settings"] = EffectiveSettingsJson(settings, options);
-  j["mode"] = options.threaded ? (options.mapping_thread ? "threaded (mapping thread)" : "threaded")
-                               : "sequential";
+  j["mode"] = !options.threaded        ? "sequential"
+              : options.realtime        ? (options.mapping_thread ? "camera rate (mapping thread)"
+                                                                  : "camera rate")
+              : options.mapping_thread  ? "threaded (mapping thread)"
+                                        : "threaded";
   j["camera"] = {{"fx", settings.camera.fx},
                  {"fy", settings.camera.fy},
                  {"cx", settings.camera.cx},
@@ -209,6 +212,20 @@ void WriteRunOutputs(const RgbdSource& dataset, const Settings& settings, const 
   }
   j["vocabulary"] = slam.vocabulary_path();
   j["wall_s"] = summary.wall_s;
+  if (options.realtime) {
+    const size_t dropped = summary.dropped_frames.size();
+    j["realtime"] = {
+        {"offered", summary.offered},
+        {"dropped", dropped},
+        {"dropped_fraction", summary.offered ? static_cast<double>(dropped) / summary.offered : 0.0},
+        {"dropped_frames", summary.dropped_frames},
+        {"processed_fps", summary.wall_s > 0 ? summary.frames / summary.wall_s : 0.0},
+        {"latency_ms",
+         {{"median", summary.latency.median},
+          {"mean", summary.latency.mean},
+          {"p99", summary.latency_p99_ms},
+          {"max", summary.latency.max}}}};
+  }
   j["segmenter"] = summary.segmenter.empty() ? "none" : summary.segmenter;
   const DetSlamOptions& dyn = options.slam.dynamic;
   j["dynamic_filter"] = {{"classes", dyn.filter.dynamic_classes},
@@ -248,6 +265,7 @@ void WriteRunOutputs(const RgbdSource& dataset, const Settings& settings, const 
                          {"extraction_ms", r.timings.extraction_ms},
                          {"tracking_ms", r.timings.tracking_ms},
                          {"mapping_ms", r.timings.mapping_ms}});
+    if (r.latency_ms >= 0) per_frame.back()["latency_ms"] = r.latency_ms;
   }
   j["per_frame"] = per_frame;
   WriteFileAtomically((out / "run.json").string(),

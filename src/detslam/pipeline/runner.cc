@@ -129,6 +129,7 @@ class RunRecorder {
     trk_.push_back(r.timings.tracking_ms);
     total_ms_.push_back(r.segmentation_ms + r.timings.extraction_ms + r.timings.tracking_ms +
                         r.timings.mapping_ms);
+    if (r.latency_ms >= 0) latency_.push_back(r.latency_ms);
     summary_.reports.push_back(r);
     if (progress_) progress_(summary_.frames, total_, r);
   }
@@ -153,6 +154,12 @@ class RunRecorder {
                      const std::vector<Instance>& instances, const cv::Mat& depth_m) {
     if (!options.keyframe_masks && options.dense_map.empty()) return;
     mask_recorder_.AddFrame(frame, keyframe, instances, depth_m);
+  }
+
+  // Camera-rate mode: frames the camera offered and those it dropped.
+  void SetCamera(size_t offered, std::vector<int64_t> dropped) {
+    summary_.offered = offered;
+    summary_.dropped_frames = std::move(dropped);
   }
 
   // Starts `slam` from options.load_map (if any); recorded in the summary.
@@ -195,6 +202,8 @@ class RunRecorder {
     summary_.tracking = ComputeErrorStats(trk_);
     summary_.mapping = ComputeErrorStats(slam.mapping_times_ms());
     summary_.total = ComputeErrorStats(total_ms_);
+    summary_.latency = ComputeErrorStats(latency_);
+    summary_.latency_p99_ms = Percentile(latency_, 99);
     summary_.wall_s =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     WriteRunOutputs(dataset, settings, options, slam, mask_recorder_.Finish(), segmenter != nullptr,
@@ -206,7 +215,7 @@ class RunRecorder {
   size_t total_;
   ProgressFn progress_;
   RunSummary summary_;
-  std::vector<double> seg_, ext_, trk_, total_ms_;
+  std::vector<double> seg_, ext_, trk_, total_ms_, latency_;
   KeyframeMaskRecorder mask_recorder_;
 };
 
@@ -227,28 +236,68 @@ struct LoadedFrame {
   std::vector<Instance> instances;
   bool segmented = false;
   double segmentation_ms = 0;
+  std::chrono::steady_clock::time_point arrival;  // camera-rate mode: when the camera offered it
 };
 
-LoadedFrame LoadAndSegment(const RgbdSource& dataset, const Settings& settings, size_t i,
-                           SlamSystem* slam) {
+LoadedFrame LoadFrame(const RgbdSource& dataset, const Settings& settings, size_t i) {
   LoadedFrame f;
   f.index = static_cast<int64_t>(i);
   try {
     f.images = dataset.Load(i, settings.camera);
   } catch (const InputError& e) {
     f.unreadable = e.what();
-    return f;
   }
-  SegmenterInput in;
-  in.index = f.index;
-  in.stamp = dataset.stamp(i);
-  in.bgr = f.images.bgr;
-  in.depth_m = f.images.depth_m;
-  FrameInstances dynamic = slam->SegmentFrame(in, f.images.gray);
-  f.instances = std::move(dynamic.instances);
-  f.segmented = dynamic.segmented;
-  f.segmentation_ms = dynamic.segmentation_ms;
   return f;
+}
+
+// The Det-SLAM stage's segmentation of a loaded frame (nothing for an unreadable one).
+void Segment(const RgbdSource& dataset, SlamSystem* slam, LoadedFrame* f) {
+  if (!f->unreadable.empty()) return;
+  SegmenterInput in;
+  in.index = f->index;
+  in.stamp = dataset.stamp(static_cast<size_t>(f->index));
+  in.bgr = f->images.bgr;
+  in.depth_m = f->images.depth_m;
+  FrameInstances dynamic = slam->SegmentFrame(in, f->images.gray);
+  f->instances = std::move(dynamic.instances);
+  f->segmented = dynamic.segmented;
+  f->segmentation_ms = dynamic.segmentation_ms;
+}
+
+LoadedFrame LoadAndSegment(const RgbdSource& dataset, const Settings& settings, size_t i,
+                           SlamSystem* slam) {
+  LoadedFrame f = LoadFrame(dataset, settings, i);
+  Segment(dataset, slam, &f);
+  return f;
+}
+
+// Camera-rate mode: offers the frames at their timestamps (relative to the first one's, from
+// now) into `camera`, which holds one frame; a frame not taken before the next arrives is
+// dropped (its index appended to *dropped). Frames are read ahead of their arrival. Returns the
+// number offered.
+size_t OfferAtCameraRate(const RgbdSource& dataset, const Settings& settings, size_t n,
+                         const RunOptions& options, BoundedQueue<LoadedFrame>* camera,
+                         std::vector<int64_t>* dropped) {
+  using Clock = std::chrono::steady_clock;
+  const Clock::time_point start = Clock::now();
+  const double first = n > 0 ? dataset.stamp(0).Seconds() : 0.0;
+  Clock::time_point previous = start;
+  size_t offered = 0;
+  for (size_t i = 0; i < n && !StopRequested(options); ++i) {
+    LoadedFrame f = LoadFrame(dataset, settings, i);
+    const double after = std::max(0.0, dataset.stamp(i).Seconds() - first);
+    const Clock::time_point due = std::max(
+        previous, start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(after)));
+    // In steps, so that a stop is seen within 20 ms.
+    for (Clock::time_point now = Clock::now(); now < due && !StopRequested(options); now = Clock::now())
+      std::this_thread::sleep_until(std::min(due, now + std::chrono::milliseconds(20)));
+    f.arrival = previous = std::max(due, Clock::now());
+    std::optional<LoadedFrame> old;
+    if (!camera->PushDroppingOldest(std::move(f), &old)) break;
+    if (old) dropped->push_back(old->index);
+    ++offered;
+  }
+  return offered;
 }
 
 // The report of a frame whose images could not be read (f.unreadable is set).
@@ -347,13 +396,18 @@ RunSummary RunThreaded(const RgbdSource& dataset, const Settings& settings,
     bool segmented = false;
     cv::Mat depth_m;
     cv::Mat bgr;  // for the observer (only with one)
+    std::chrono::steady_clock::time_point arrival;  // camera-rate mode
   };
   RunObserver* observer = options.observer;
   if (observer) observer->OnStart(n, /*pausable=*/false);
-  BoundedQueue<LoadedFrame> loaded(options.queue_capacity);
-  BoundedQueue<Extracted> extracted(options.queue_capacity);
+  // At camera rate a frame waits in no queue longer than it must: one frame between stages.
+  const size_t capacity = options.realtime ? 1 : options.queue_capacity;
+  BoundedQueue<LoadedFrame> camera(1);  // camera-rate mode: the camera's newest frame
+  BoundedQueue<LoadedFrame> loaded(capacity);
+  BoundedQueue<Extracted> extracted(capacity);
   BoundedQueue<KeyFrameId> keyframes(8);
   const auto close_queues = [&] {
+    camera.Close();
     loaded.Close();
     extracted.Close();
     keyframes.Close();
@@ -361,9 +415,24 @@ RunSummary RunThreaded(const RgbdSource& dataset, const Settings& settings,
   StageThreads stages(close_queues);
   // A stop drops the frames and keyframes still queued: every stage ends after its current item.
   const StopWatcher watcher(options, &slam, close_queues);
+  size_t offered = 0;
+  std::vector<int64_t> dropped;  // the camera thread's until Join
+  if (options.realtime) {
+    stages.Start(
+        "camera", [&] { offered = OfferAtCameraRate(dataset, settings, n, options, &camera, &dropped); },
+        [&] { camera.Close(); });
+  }
   stages.Start(
-      "loading",
+      options.realtime ? "segmentation" : "loading",
       [&] {
+        if (options.realtime) {
+          while (std::optional<LoadedFrame> f = camera.Pop()) {
+            if (StopRequested(options)) break;
+            Segment(dataset, &slam, &*f);
+            if (!loaded.Push(std::move(*f))) break;
+          }
+          return;
+        }
         for (size_t i = 0; i < n && !StopRequested(options); ++i) {
           if (!loaded.Push(LoadAndSegment(dataset, settings, i, &slam))) break;
         }
@@ -384,6 +453,7 @@ RunSummary RunThreaded(const RgbdSource& dataset, const Settings& settings,
             e.depth_m = f->images.depth_m;
             if (observer) e.bgr = f->images.bgr;
           }
+          e.arrival = f->arrival;
           if (!extracted.Push(std::move(e))) break;
         }
       },
@@ -410,6 +480,11 @@ RunSummary RunThreaded(const RgbdSource& dataset, const Settings& settings,
           Frame tracked;
           const KeyFrameId kf =
               slam.TrackFrame(std::move(e->frame), &e->report, observer ? &tracked : nullptr);
+          if (options.realtime) {
+            e->report.latency_ms = std::chrono::duration<double, std::milli>(
+                                       std::chrono::steady_clock::now() - e->arrival)
+                                       .count();
+          }
           recorder.AddFrameMasks(options, e->report.index, kf != kNoKeyFrame, e->instances,
                                  e->depth_m);
           if (kf != kNoKeyFrame) {
@@ -426,11 +501,14 @@ RunSummary RunThreaded(const RgbdSource& dataset, const Settings& settings,
       },
       [&] { keyframes.Close(); });
   stages.Join();
+  if (options.realtime) recorder.SetCamera(offered, std::move(dropped));
   return Finish(recorder, dataset, settings, options, slam, start, segmenter);
 }
 
 RunSummary Run(const RgbdSource& dataset, const Settings& settings, const RunOptions& options,
                const ProgressFn& progress, Segmenter* segmenter) {
+  if (options.realtime && !options.threaded)
+    throw InputError("the camera-rate mode needs the threaded pipeline (RunOptions::threaded)");
   return options.threaded ? RunThreaded(dataset, settings, options, progress, segmenter)
                           : RunSequential(dataset, settings, options, progress, segmenter);
 }

@@ -25,6 +25,12 @@ struct RunOptions {
   bool threaded = false;        // one thread per stage (see RunThreaded)
   bool mapping_thread = false;  // threaded: local mapping in its own thread (not deterministic)
   size_t queue_capacity = 4;    // frames buffered between the threaded stages
+  // Camera-rate mode (threaded only; RunThreaded): a camera thread offers frame i when its
+  // timestamp comes (relative to the first frame's), as a live camera delivers them, and holds one
+  // frame: a frame the pipeline has not taken when the next arrives is dropped, never queued
+  // (RunSummary::dropped_frames). The queues between the stages then hold one frame each, and each
+  // processed frame's latency from its arrival to its pose goes into FrameReport::latency_ms.
+  bool realtime = false;
   std::string save_map;         // write the final map to this map file (empty: none)
   std::string load_map;         // start from the map in this map file (empty: a new map)
   // The dense static map (dense/dense_fusion.h): after the run, the main map's keyframes are fused
@@ -70,6 +76,13 @@ struct RunSummary {
   uint64_t loaded_keyframes = 0, loaded_landmarks = 0;  // of the map loaded (load_map)
   double map_load_ms = 0;                               // reading and restoring it
   std::vector<LoopRecord> loop_records;
+  // Camera-rate mode (RunOptions::realtime): frames the camera offered, the indices of those
+  // dropped because the pipeline was busy, and the latency from a frame's arrival to its pose over
+  // the frames processed (ms; also its 99th percentile).
+  size_t offered = 0;
+  std::vector<int64_t> dropped_frames;
+  ErrorStats latency;
+  double latency_p99_ms = 0;
   size_t keyframe_masks = 0;  // written to out_dir/keyframe_masks
   DenseMapStats dense;        // of the dense map (dense_map)
   double wall_s = 0;
@@ -92,7 +105,9 @@ RunSummary RunSequential(const RgbdSource& dataset, const Settings& settings,
                          Segmenter* segmenter = nullptr);
 
 // Threaded mode: a loader/segmentation thread feeds an extraction thread, which feeds the
-// tracking thread (the calling one), through bounded queues (closing a queue ends the stream).
+// tracking thread (the calling one), through bounded queues (closing a queue ends the stream);
+// with options.realtime a camera thread loads the frames and offers them at their timestamps to
+// the segmentation thread, dropping those it cannot take.
 // With options.mapping_thread, local mapping runs in a fourth thread fed by a keyframe queue
 // (results then depend on timing); without it, mapping runs in the tracking thread and the
 // trajectory equals the sequential one. An exception in any stage stops the others and is

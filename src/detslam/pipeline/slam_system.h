@@ -97,6 +97,9 @@ struct FrameReport {
   int map_keyframes = 0;
   int map_points = 0;
   FrameTimings timings;
+  // Camera-rate mode (RunOptions::realtime): milliseconds from the frame's arrival to its pose
+  // (the end of tracking); -1 otherwise.
+  double latency_ms = -1;
   // Why the frame was skipped (its images could not be read: corrupt, wrong type or size, gone);
   // empty for a processed frame. A skipped frame has no pose and is not seen by tracking.
   std::string skipped;

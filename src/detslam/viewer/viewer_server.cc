@@ -4,9 +4,11 @@
 #include <sys/socket.h>
 #include <spdlog/spdlog.h>
 
+#include <chrono>
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
+#include <thread>
 
 #include "detslam/core/check.h"
 #include "detslam/viewer/viewer_assets.h"
@@ -114,6 +116,17 @@ ViewerServer::ViewerServer(ViewerContent* content, const ViewerServerOptions& op
                      std::to_string(options_.port) + " (port in use?)");
   }
   thread_ = std::thread([this] { server_->listen_after_bind(); });
+  // httplib's stop() does nothing before the listening thread has entered its accept loop, which
+  // would then accept for ever and the destructor's join hang: return once it listens.
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+  while (!server_->is_running() && std::chrono::steady_clock::now() < deadline)
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  if (!server_->is_running()) {  // its listen ended at once (the thread has finished)
+    stopping_ = true;
+    thread_.join();
+    throw InputError("viewer: the server on " + options_.host + ":" + std::to_string(port_) +
+                     " did not start");
+  }
 }
 
 ViewerServer::~ViewerServer() { Stop(); }
