@@ -39,6 +39,8 @@ RunLog ReadRunLog(const std::string& path) {
     const int line = 1 + static_cast<int>(std::count(
                              text.begin(), text.begin() + static_cast<std::ptrdiff_t>(at), '\n'));
     throw InputError(path, line, std::string("not valid JSON: ") + e.what());
+  } catch (const json::exception& e) {  // e.g. a number too large for any type (out_of_range)
+    throw InputError(path, 0, std::string("not valid JSON: ") + e.what());
   }
   if (!j.is_object()) throw InputError(path, 0, "run log must be a JSON object");
   RunLog r;

@@ -157,6 +157,9 @@ TEST_F(RunLogTest, BadInputNamesTheFileLineAndKey) {
   EXPECT_THAT(Error(Write(RunJson(std::string(kFrame) + ", " + frame))),
               HasSubstr("per_frame[1]: key 'tracked' has the wrong type"));
   EXPECT_THAT(Error(Write("[1, 2]")), HasSubstr("must be a JSON object"));
+  // A number no type can hold (found by the run_log fuzz target): an error, not an exception
+  // that escapes.
+  EXPECT_THAT(Error(Write(RunJson("39e9943"))), HasSubstr("not valid JSON"));
 }
 
 }  // namespace
