@@ -38,6 +38,7 @@ struct RunArgs {
   bool localization = false;
   bool threaded = false;
   bool realtime = false;  // --realtime: frames offered at their timestamps (implies threaded)
+  bool sync_segmentation = false;  // --sync-segmentation: with --realtime, segment every frame taken
   bool inline_mapping = false;
   std::string segmenter;  // empty: dnn if the models are found, else none
   std::string models;
@@ -135,6 +136,7 @@ void Run(RunArgs a) {
   options.dense = a.dense;
   options.threaded = a.threaded;
   options.realtime = a.realtime;
+  options.async_segmentation = !a.sync_segmentation;
   options.slam = SlamOptionsFromSettings(settings, a.seed);
   options.mapping_thread = a.threaded && !a.inline_mapping;
   if (a.alpha >= 0) options.slam.dynamic.filter.alpha = a.alpha;
@@ -189,7 +191,13 @@ void Run(RunArgs a) {
     std::printf("camera rate: %zu frames offered, %zu dropped (%.1f%%) because the pipeline was busy, %.1f frames/s processed; "
                 "latency from arrival to pose: median %.1f ms, 99th percentile %.1f ms\n",
                 s.offered, s.dropped_frames.size(), s.offered ? 100.0 * s.dropped_frames.size() / s.offered : 0.0,
-                s.wall_s > 0 ? s.frames / s.wall_s : 0.0, s.latency.median, s.latency_p99_ms);
+                s.ProcessedFps(), s.latency.median, s.latency_p99_ms);
+    if (s.async_segmentation) {
+      std::printf("asynchronous segmentation: %zu frames segmented; masks used %.1f frames old (median, max %.0f); "
+                  "%zu keyframes deferred for masks older than %d frames\n",
+                  s.frames_segmented, s.mask_age.median, s.mask_age.max, s.keyframes_deferred,
+                  options.slam.dynamic.keyframe_max_mask_age);
+    }
   }
   if (!s.segmenter.empty()) std::printf("segmentation (%s): median %.1f ms per frame\n", s.segmenter.c_str(), s.segmentation.median);
   std::printf("median ms per frame: extraction %.1f, tracking %.1f, total %.1f; local mapping %.1f per keyframe\n",
@@ -255,6 +263,8 @@ void AddRunCommand(CLI::App& app) {
                 "One thread per stage: loading+segmentation, extraction, tracking, local mapping (real-time use; not bit-reproducible)");
   cmd->add_flag("--realtime", args->realtime,
                 "Camera rate: offer the frames at their timestamps as a live camera would (implies --threaded); a frame the pipeline has not taken when the next arrives is dropped, never queued; run.json reports the frames dropped and each frame's latency from arrival to pose");
+  cmd->add_flag("--sync-segmentation", args->sync_segmentation,
+                "With --realtime: segment each frame taken before extracting it (the pipeline waits for the detector); default: asynchronous segmentation, each frame uses the newest masks carried to it by optical flow");
   cmd->add_flag("--inline-mapping", args->inline_mapping,
                 "With --threaded: local mapping in the tracking thread (then the trajectory equals the sequential one)");
   cmd->add_flag("--no-progress", args->no_progress, "No progress bar");

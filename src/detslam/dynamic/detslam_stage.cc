@@ -21,8 +21,8 @@ bool DetSlamOptions::Check(std::string* error) const {
     if (error) *error = "mask propagation: " + e;
     return false;
   }
-  if (memory_frames < 0 || segment_every < 1) {
-    if (error) *error = "memory_frames must be >= 0 and segment_every >= 1";
+  if (memory_frames < 0 || segment_every < 1 || keyframe_max_mask_age < 0) {
+    if (error) *error = "memory_frames must be >= 0, segment_every >= 1 and keyframe_max_mask_age >= 0";
     return false;
   }
   if (error) error->clear();
@@ -49,6 +49,17 @@ FrameInstances DetSlamStage::Segment(const SegmenterInput& input, const cv::Mat&
     out.instances = memory_.Update(segmenter_->Segment(input));
     if (every > 1) propagator_.Reset(gray, out.instances);
   }
+  out.segmented = true;
+  out.segmentation_ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  return out;
+}
+
+FrameInstances DetSlamStage::Detect(const SegmenterInput& input) {
+  FrameInstances out;
+  if (segmenter_ == nullptr) return out;
+  const auto t0 = std::chrono::steady_clock::now();
+  out.instances = memory_.Update(segmenter_->Segment(input));
   out.segmented = true;
   out.segmentation_ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();

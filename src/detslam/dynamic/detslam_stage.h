@@ -29,6 +29,10 @@ struct DetSlamOptions {
   bool premask = true;          // also drop dynamic corners before the ORB spatial distribution
   int memory_frames = 3;        // carry lost instances forward this many frames (0.1 s)
   int segment_every = 1;        // segmenter on every k-th frame; masks follow the flow in between
+  // Asynchronous segmentation (camera-rate mode): a frame whose masks were segmented on a frame
+  // more than this many input frames older does not become a keyframe (no new map points from
+  // stale masks); the tracker asks again on the next frame. Frames with their own masks have age 0.
+  int keyframe_max_mask_age = 6;  // chosen on walking_xyz tuning seeds 1-3 (bench_realtime.sh)
   MaskPropagationOptions propagation;  // how masks move between segmented frames
   MoverCheckOptions geometric;         // geometric check for movers the segmenter missed (tracker)
 
@@ -59,6 +63,11 @@ class DetSlamStage {
   // Loader side: the dynamic instances of the frame `input` describes (`gray`: its CV_8UC1 image,
   // for the mask propagation). Frames must come in input order.
   FrameInstances Segment(const SegmenterInput& input, const cv::Mat& gray);
+
+  // Asynchronous segmentation's thread (frames in input order, not necessarily every frame): the
+  // segmenter and the instance memory on the frame, no propagation (MaskCarrier carries the result
+  // to the frames that did not wait for it).
+  FrameInstances Detect(const SegmenterInput& input);
 
   // Extraction side: ORB keypoints of `gray` with their depth and labels. `instances`: null when
   // the frame was not segmented (every keypoint static). `ignore_mask`: empty or CV_8UC1,

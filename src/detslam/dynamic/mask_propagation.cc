@@ -51,29 +51,42 @@ cv::Mat ShiftMask(const cv::Mat& mask, double dx, double dy) {
 void MaskPropagator::Reset(const cv::Mat& gray, std::vector<Instance> instances) {
   DETSLAM_CHECK(gray.type() == CV_8UC1);
   last_gray_ = gray.clone();
+  last_pyramid_.clear();
   instances_ = std::move(instances);
   age_ = 0;
 }
 
-std::vector<Instance> MaskPropagator::Propagate(const cv::Mat& gray) {
+std::vector<Instance> MaskPropagator::Propagate(const cv::Mat& gray, int frames) {
   DETSLAM_CHECK(gray.type() == CV_8UC1);
+  DETSLAM_CHECK(frames >= 1);
   if (last_gray_.empty()) return {};
   DETSLAM_CHECK_MSG(gray.size() == last_gray_.size(), "image size changed during the sequence");
-  ++age_;
+  age_ += frames;
   const cv::Rect image(0, 0, gray.cols, gray.rows);
+  const cv::Size window(21, 21);
+  constexpr int kLevels = 3;
+  // Both images' pyramids are built once per call (not once per instance); this frame's is the
+  // next call's previous one.
+  std::vector<cv::Mat> pyramid;
+  if (!instances_.empty()) {
+    if (last_pyramid_.empty()) cv::buildOpticalFlowPyramid(last_gray_, last_pyramid_, window, kLevels);
+    cv::buildOpticalFlowPyramid(gray, pyramid, window, kLevels);
+  }
   for (Instance& inst : instances_) {
-    cv::Mat region = inst.mask;
-    if (region.empty()) {
-      region = cv::Mat::zeros(gray.size(), CV_8UC1);
-      region(inst.box & image).setTo(255);
-    }
+    // Corners inside the instance, searched in its box only (not over the whole image).
+    const cv::Rect roi = inst.box & image;
+    cv::Mat region;
+    if (!inst.mask.empty()) region = inst.mask(roi);
     std::vector<cv::Point2f> from, to;
-    cv::goodFeaturesToTrack(last_gray_, from, options_.max_corners, 0.01, 5, region);
+    if (!roi.empty()) {
+      cv::goodFeaturesToTrack(last_gray_(roi), from, options_.max_corners, 0.01, 5, region);
+      for (cv::Point2f& p : from) p += cv::Point2f(static_cast<float>(roi.x), static_cast<float>(roi.y));
+    }
     double dx = 0, dy = 0;
     if (!from.empty()) {
       std::vector<uchar> status;
       std::vector<float> err;
-      cv::calcOpticalFlowPyrLK(last_gray_, gray, from, to, status, err, cv::Size(21, 21), 3);
+      cv::calcOpticalFlowPyrLK(last_pyramid_, pyramid, from, to, status, err, window, kLevels);
       std::vector<float> fx, fy;
       for (size_t i = 0; i < from.size(); ++i) {
         if (!status[i]) continue;
@@ -94,6 +107,7 @@ std::vector<Instance> MaskPropagator::Propagate(const cv::Mat& gray) {
                                   [](const Instance& i) { return i.box.empty(); }),
                    instances_.end());  // moved out of view
   last_gray_ = gray.clone();
+  last_pyramid_ = std::move(pyramid);
   std::vector<Instance> out = instances_;
   const int grow = options_.grow_px_per_frame * age_;
   for (Instance& inst : out) {

@@ -26,16 +26,18 @@ class MaskPropagator {
 
   // A segmented frame: its grey image (CV_8UC1) and instances become the new reference.
   void Reset(const cv::Mat& gray, std::vector<Instance> instances);
-  // A frame without segmentation: the last frame's instances moved into `gray`. Empty before the
-  // first Reset.
-  std::vector<Instance> Propagate(const cv::Mat& gray);
+  // A frame without segmentation: the last frame's instances moved into `gray`, which comes
+  // `frames` (>= 1) input frames after the last one (frames dropped in between count: the masks
+  // grow with the time elapsed). Empty before the first Reset.
+  std::vector<Instance> Propagate(const cv::Mat& gray, int frames = 1);
 
-  // Frames since the last Reset (0 right after it).
+  // Input frames since the last Reset (0 right after it).
   int age() const { return age_; }
 
  private:
   MaskPropagationOptions options_;
   cv::Mat last_gray_;
+  std::vector<cv::Mat> last_pyramid_;  // of last_gray_, built on first use
   std::vector<Instance> instances_;  // in last_gray_, not yet grown
   int age_ = 0;
 };

@@ -1,5 +1,9 @@
 #include "detslam/dynamic/mask_propagation.h"
 
+#include <thread>
+
+#include "detslam/dynamic/mask_carrier.h"
+
 #include <gtest/gtest.h>
 
 #include <opencv2/imgproc.hpp>
@@ -65,6 +69,94 @@ TEST(MaskPropagation, MasksFollowTheMovingObjectAndGrowWithAge) {
   // A new segmentation resets the age.
   p.Reset(SquareImage({112, 86}), {Square({112, 86})});
   EXPECT_EQ(p.age(), 0);
+}
+
+TEST(MaskPropagation, AJumpOverSeveralFramesGrowsTheMaskByTheirNumber) {
+  MaskPropagationOptions o;
+  o.grow_px_per_frame = 2;
+  MaskPropagator p(o);
+  p.Reset(SquareImage({100, 80}), {Square({100, 80})});
+  // Three input frames later (two dropped in between): moved by the whole motion, grown by 6 px.
+  const std::vector<Instance> out = p.Propagate(SquareImage({112, 86}), 3);
+  ASSERT_EQ(out.size(), 1u);
+  EXPECT_EQ(p.age(), 3);
+  const cv::Point2d c = Centroid(out[0].mask);
+  EXPECT_NEAR(c.x, 142, 1.0);
+  EXPECT_NEAR(c.y, 116, 1.0);
+  EXPECT_EQ(out[0].box, cv::Rect(106, 80, 72, 72));
+  EXPECT_DEATH(p.Propagate(SquareImage({112, 86}), 0), "");
+}
+
+TEST(MaskCarrier, NothingBeforeTheFirstPublishedSegmentation) {
+  MaskCarrier carrier;
+  EXPECT_FALSE(carrier.Carry(0, SquareImage({50, 50})).has_value());
+  EXPECT_EQ(carrier.published(), 0);
+}
+
+TEST(MaskCarrier, CarriesTheNewestSegmentationToLaterFramesWithItsAge) {
+  MaskPropagationOptions o;
+  o.grow_px_per_frame = 2;
+  MaskCarrier carrier(o);
+  // The object moves 3 px right per input frame.
+  const auto image = [](int frame) { return SquareImage({100 + 3 * frame, 80}); };
+  const auto square = [](int frame) { return Square({100 + 3 * frame, 80}); };
+  carrier.Publish(0, image(0), {square(0)});
+  std::optional<CarriedInstances> c = carrier.Carry(0, image(0));  // its own segmentation
+  ASSERT_TRUE(c.has_value());
+  EXPECT_EQ(c->source, 0);
+  EXPECT_EQ(c->age, 0);
+  ASSERT_EQ(c->instances.size(), 1u);
+  EXPECT_EQ(c->instances[0].box, cv::Rect(100, 80, 60, 60));
+  // Frames 1 and 3 (2 dropped): carried by the flow, age counted in input frames.
+  c = carrier.Carry(1, image(1));
+  ASSERT_TRUE(c.has_value());
+  EXPECT_EQ(c->age, 1);
+  EXPECT_NEAR(Centroid(c->instances[0].mask).x, 133, 1.0);
+  c = carrier.Carry(3, image(3));
+  ASSERT_TRUE(c.has_value());
+  EXPECT_EQ(c->age, 3);
+  EXPECT_NEAR(Centroid(c->instances[0].mask).x, 139, 1.0);
+  EXPECT_EQ(c->instances[0].box, cv::Rect(109 - 6, 80 - 6, 72, 72));
+  // The segmentation of frame 2 arrives while frame 4 is carried: it replaces the older one, is
+  // carried from frame 2's image, and its age is 2.
+  carrier.Publish(2, image(2), {square(2)});
+  c = carrier.Carry(4, image(4));
+  ASSERT_TRUE(c.has_value());
+  EXPECT_EQ(c->source, 2);
+  EXPECT_EQ(c->age, 2);
+  EXPECT_NEAR(Centroid(c->instances[0].mask).x, 142, 1.0);
+  EXPECT_EQ(c->instances[0].box, cv::Rect(112 - 4, 80 - 4, 68, 68));
+  // A result older than the newest published one is ignored; one of a frame not carried yet
+  // waits for it.
+  carrier.Publish(1, image(1), {});
+  carrier.Publish(6, image(6), {});
+  c = carrier.Carry(5, image(5));
+  ASSERT_TRUE(c.has_value());
+  EXPECT_EQ(c->source, 2);
+  EXPECT_EQ(c->instances.size(), 1u);
+  c = carrier.Carry(6, image(6));
+  ASSERT_TRUE(c.has_value());
+  EXPECT_EQ(c->source, 6);
+  EXPECT_TRUE(c->instances.empty());
+  EXPECT_EQ(carrier.published(), 3);
+  EXPECT_DEATH(carrier.Carry(6, image(6)), "");  // frames out of input order
+}
+
+TEST(MaskCarrier, WaitForReturnsWhenPublishedOrClosed) {
+  MaskCarrier carrier;
+  std::thread segmentation([&] {
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    carrier.Publish(3, SquareImage({50, 50}), {});
+  });
+  EXPECT_TRUE(carrier.WaitFor(3));
+  segmentation.join();
+  EXPECT_TRUE(carrier.WaitFor(2));  // a later frame's masks do
+  std::thread closer([&] {
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    carrier.Close();
+  });
+  EXPECT_FALSE(carrier.WaitFor(10));
+  closer.join();
 }
 
 TEST(MaskPropagation, ShiftMaskMovesPixelsAndClearsTheBorder) {

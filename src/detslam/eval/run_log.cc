@@ -76,6 +76,16 @@ RunLog ReadRunLog(const std::string& path) {
     r.realtime.latency_median_ms = Get<double>(latency, "median", path, "realtime.latency_ms: ");
     r.realtime.latency_p99_ms = Get<double>(latency, "p99", path, "realtime.latency_ms: ");
     r.realtime.latency_max_ms = Get<double>(latency, "max", path, "realtime.latency_ms: ");
+    if (t.contains("asynchronous_segmentation")) {
+      r.realtime.asynchronous = Get<bool>(t, "asynchronous_segmentation", path, "realtime: ");
+    }
+    if (r.realtime.asynchronous) {
+      r.realtime.frames_segmented = Get<int64_t>(t, "frames_segmented", path, "realtime: ");
+      r.realtime.keyframes_deferred = Get<int64_t>(t, "keyframes_deferred", path, "realtime: ");
+      const json age = Get<json>(t, "mask_age_frames", path, "realtime: ");
+      r.realtime.mask_age_median = Get<double>(age, "median", path, "realtime.mask_age_frames: ");
+      r.realtime.mask_age_max = Get<double>(age, "max", path, "realtime.mask_age_frames: ");
+    }
   }
   const json frames = Get<json>(j, "per_frame", path, "");
   if (!frames.is_array()) throw InputError(path, 0, "key 'per_frame' must be an array");

@@ -42,6 +42,10 @@ struct RunRealtimeLog {
   int64_t offered = 0, dropped = 0;
   double processed_fps = 0;
   double latency_median_ms = 0, latency_p99_ms = 0, latency_max_ms = 0;
+  // Asynchronous segmentation (absent in older files and with --sync-segmentation: false).
+  bool asynchronous = false;
+  int64_t frames_segmented = 0, keyframes_deferred = 0;
+  double mask_age_median = 0, mask_age_max = 0;  // input frames
 };
 
 struct RunLog {

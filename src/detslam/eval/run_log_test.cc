@@ -137,8 +137,26 @@ TEST_F(RunLogTest, ReadsTheCameraRateBlockOfRealtimeRuns) {
   EXPECT_DOUBLE_EQ(r.realtime.latency_median_ms, 150.5);
   EXPECT_DOUBLE_EQ(r.realtime.latency_p99_ms, 270.25);
   EXPECT_DOUBLE_EQ(r.realtime.latency_max_ms, 300.0);
+  EXPECT_FALSE(r.realtime.asynchronous);  // a file without the key (written before it existed)
   text.replace(text.find("\"p99\": 270.25"), 13, "\"p99\": null");
   EXPECT_THAT(Error(Write(text)), HasSubstr("realtime.latency_ms: key 'p99' has the wrong type"));
+}
+
+TEST_F(RunLogTest, ReadsTheAsynchronousSegmentationCounters) {
+  std::string text = RunJson(kFrame);
+  text.replace(text.find("\"per_frame\""), 0,
+               R"("realtime": {"offered": 300, "dropped": 20, "processed_fps": 28.5,
+               "latency_ms": {"median": 40, "mean": 42, "p99": 80, "max": 90},
+               "asynchronous_segmentation": true, "frames_segmented": 95,
+               "mask_age_frames": {"median": 4, "mean": 4.2, "max": 11}, "keyframes_deferred": 7}, )");
+  const RunLog r = ReadRunLog(Write(text));
+  EXPECT_TRUE(r.realtime.asynchronous);
+  EXPECT_EQ(r.realtime.frames_segmented, 95);
+  EXPECT_EQ(r.realtime.keyframes_deferred, 7);
+  EXPECT_DOUBLE_EQ(r.realtime.mask_age_median, 4.0);
+  EXPECT_DOUBLE_EQ(r.realtime.mask_age_max, 11.0);
+  text.replace(text.find("\"frames_segmented\": 95,"), 23, "");
+  EXPECT_THAT(Error(Write(text)), HasSubstr("frames_segmented"));
 }
 
 TEST_F(RunLogTest, BadInputNamesTheFileLineAndKey) {

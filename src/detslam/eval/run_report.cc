@@ -282,6 +282,14 @@ std::string RenderHtmlReport(const RunLog& run, const EvalResult* eval) {
                        Fixed(t.latency_median_ms, 1) + " ms, 99th percentile " +
                        Fixed(t.latency_p99_ms, 1) + " ms, max " + Fixed(t.latency_max_ms, 1) +
                        " ms");
+    if (t.asynchronous) {
+      os << TableRow("asynchronous segmentation",
+                     std::to_string(t.frames_segmented) +
+                         " frames segmented; masks carried to each frame were " +
+                         Fixed(t.mask_age_median, 0) + " frames old (median; max " +
+                         Fixed(t.mask_age_max, 0) + "); " + std::to_string(t.keyframes_deferred) +
+                         " keyframes deferred for stale masks");
+    }
   }
   const ErrorStats s = ComputeErrorStats(seg), e = ComputeErrorStats(ext),
                    t = ComputeErrorStats(trk);

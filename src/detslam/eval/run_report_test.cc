@@ -123,6 +123,15 @@ TEST(RunReport, ACameraRateRunShowsItsDropsAndLatency) {
   const std::string html = RenderHtmlReport(log, nullptr);
   EXPECT_THAT(html, HasSubstr("60 frames offered, 40 dropped (66.7 %)"));
   EXPECT_THAT(html, HasSubstr("median 150.0 ms, 99th percentile 270.5 ms, max 300.0 ms"));
+  EXPECT_THAT(html, Not(HasSubstr("asynchronous segmentation")));
+  log.realtime.asynchronous = true;
+  log.realtime.frames_segmented = 18;
+  log.realtime.mask_age_median = 4;
+  log.realtime.mask_age_max = 9;
+  log.realtime.keyframes_deferred = 3;
+  EXPECT_THAT(RenderHtmlReport(log, nullptr),
+              HasSubstr("18 frames segmented; masks carried to each frame were 4 frames old "
+                        "(median; max 9); 3 keyframes deferred for stale masks"));
 }
 
 TEST(RunReport, HtmlWithEvaluationEmbedsTheAccuracyFigure) {

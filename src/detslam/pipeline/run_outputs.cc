@@ -219,12 +219,21 @@ void WriteRunOutputs(const RgbdSource& dataset, const Settings& settings, const 
         {"dropped", dropped},
         {"dropped_fraction", summary.offered ? static_cast<double>(dropped) / summary.offered : 0.0},
         {"dropped_frames", summary.dropped_frames},
-        {"processed_fps", summary.wall_s > 0 ? summary.frames / summary.wall_s : 0.0},
+        {"processed_fps", summary.ProcessedFps()},
+        {"camera_s", summary.camera_s},
         {"latency_ms",
          {{"median", summary.latency.median},
           {"mean", summary.latency.mean},
           {"p99", summary.latency_p99_ms},
-          {"max", summary.latency.max}}}};
+          {"max", summary.latency.max}}},
+        {"asynchronous_segmentation", summary.async_segmentation}};
+    if (summary.async_segmentation) {
+      j["realtime"]["frames_segmented"] = summary.frames_segmented;
+      j["realtime"]["mask_age_frames"] = {{"median", summary.mask_age.median},
+                                          {"mean", summary.mask_age.mean},
+                                          {"max", summary.mask_age.max}};
+      j["realtime"]["keyframes_deferred"] = summary.keyframes_deferred;
+    }
   }
   j["segmenter"] = summary.segmenter.empty() ? "none" : summary.segmenter;
   const DetSlamOptions& dyn = options.slam.dynamic;
@@ -235,7 +244,8 @@ void WriteRunOutputs(const RgbdSource& dataset, const Settings& settings, const 
                          {"premask", dyn.premask},
                          {"memory_frames", dyn.memory_frames},
                          {"geometric_check", dyn.geometric.enabled},
-                         {"segment_every", dyn.segment_every}};
+                         {"segment_every", dyn.segment_every},
+                         {"keyframe_max_mask_age", dyn.keyframe_max_mask_age}};
   j["timings"] = {{"segmentation", StatsJson(summary.segmentation)},
                   {"extraction", StatsJson(summary.extraction)},
                   {"tracking", StatsJson(summary.tracking)},
@@ -266,6 +276,11 @@ void WriteRunOutputs(const RgbdSource& dataset, const Settings& settings, const 
                          {"tracking_ms", r.timings.tracking_ms},
                          {"mapping_ms", r.timings.mapping_ms}});
     if (r.latency_ms >= 0) per_frame.back()["latency_ms"] = r.latency_ms;
+    if (r.mask_age >= 0) {
+      per_frame.back()["mask_source"] = r.mask_source;
+      per_frame.back()["mask_age"] = r.mask_age;
+    }
+    if (r.keyframe_deferred) per_frame.back()["keyframe_deferred"] = true;
   }
   j["per_frame"] = per_frame;
   WriteFileAtomically((out / "run.json").string(),

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <chrono>
 #include <condition_variable>
+#include <deque>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -13,6 +14,7 @@
 #include <thread>
 
 #include "detslam/core/check.h"
+#include "detslam/dynamic/mask_carrier.h"
 #include "detslam/pipeline/bounded_queue.h"
 #include "detslam/pipeline/keyframe_mask_recorder.h"
 #include "detslam/pipeline/run_outputs.h"
@@ -130,6 +132,8 @@ class RunRecorder {
     total_ms_.push_back(r.segmentation_ms + r.timings.extraction_ms + r.timings.tracking_ms +
                         r.timings.mapping_ms);
     if (r.latency_ms >= 0) latency_.push_back(r.latency_ms);
+    if (r.mask_age >= 0) mask_age_.push_back(r.mask_age);
+    if (r.keyframe_deferred) ++summary_.keyframes_deferred;
     summary_.reports.push_back(r);
     if (progress_) progress_(summary_.frames, total_, r);
   }
@@ -157,9 +161,18 @@ class RunRecorder {
   }
 
   // Camera-rate mode: frames the camera offered and those it dropped.
-  void SetCamera(size_t offered, std::vector<int64_t> dropped) {
+  void SetCamera(size_t offered, std::vector<int64_t> dropped, double camera_s) {
     summary_.offered = offered;
     summary_.dropped_frames = std::move(dropped);
+    summary_.camera_s = camera_s;
+  }
+
+  // Asynchronous segmentation: the segmenter's time on each frame it segmented (they replace the
+  // per-frame times, which are then those of carrying the masks).
+  void SetAsyncSegmentation(const std::vector<double>& detection_ms) {
+    summary_.async_segmentation = true;
+    summary_.frames_segmented = detection_ms.size();
+    seg_ = detection_ms;
   }
 
   // Starts `slam` from options.load_map (if any); recorded in the summary.
@@ -178,8 +191,8 @@ class RunRecorder {
                     const Segmenter* segmenter) {
     if (segmenter != nullptr) summary_.segmenter = segmenter->name();
     if (summary_.frames > 0 && summary_.skipped == summary_.frames) {
-      throw InputError("no frame of " + dataset.name() + " could be read; the first: " +
-                       summary_.reports.front().skipped);
+      throw InputError("no frame of " + dataset.name() +
+                       " could be read; the first: " + summary_.reports.front().skipped);
     }
     summary_.segmentation = ComputeErrorStats(seg_);
     slam.WaitForGlobalBundleAdjustment();
@@ -204,10 +217,11 @@ class RunRecorder {
     summary_.total = ComputeErrorStats(total_ms_);
     summary_.latency = ComputeErrorStats(latency_);
     summary_.latency_p99_ms = Percentile(latency_, 99);
+    summary_.mask_age = ComputeErrorStats(mask_age_);
     summary_.wall_s =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     WriteRunOutputs(dataset, settings, options, slam, mask_recorder_.Finish(), segmenter != nullptr,
-                 summary_);
+                    summary_);
     return summary_;
   }
 
@@ -215,7 +229,7 @@ class RunRecorder {
   size_t total_;
   ProgressFn progress_;
   RunSummary summary_;
-  std::vector<double> seg_, ext_, trk_, total_ms_, latency_;
+  std::vector<double> seg_, ext_, trk_, total_ms_, latency_, mask_age_;
   KeyframeMaskRecorder mask_recorder_;
 };
 
@@ -236,6 +250,8 @@ struct LoadedFrame {
   std::vector<Instance> instances;
   bool segmented = false;
   double segmentation_ms = 0;
+  int64_t mask_source = -1;  // asynchronous segmentation: where its masks come from, their age
+  int mask_age = -1;
   std::chrono::steady_clock::time_point arrival;  // camera-rate mode: when the camera offered it
 };
 
@@ -250,15 +266,19 @@ LoadedFrame LoadFrame(const RgbdSource& dataset, const Settings& settings, size_
   return f;
 }
 
+SegmenterInput SegmentationInput(const RgbdSource& dataset, const LoadedFrame& f) {
+  SegmenterInput in;
+  in.index = f.index;
+  in.stamp = dataset.stamp(static_cast<size_t>(f.index));
+  in.bgr = f.images.bgr;
+  in.depth_m = f.images.depth_m;
+  return in;
+}
+
 // The Det-SLAM stage's segmentation of a loaded frame (nothing for an unreadable one).
 void Segment(const RgbdSource& dataset, SlamSystem* slam, LoadedFrame* f) {
   if (!f->unreadable.empty()) return;
-  SegmenterInput in;
-  in.index = f->index;
-  in.stamp = dataset.stamp(static_cast<size_t>(f->index));
-  in.bgr = f->images.bgr;
-  in.depth_m = f->images.depth_m;
-  FrameInstances dynamic = slam->SegmentFrame(in, f->images.gray);
+  FrameInstances dynamic = slam->SegmentFrame(SegmentationInput(dataset, *f), f->images.gray);
   f->instances = std::move(dynamic.instances);
   f->segmented = dynamic.segmented;
   f->segmentation_ms = dynamic.segmentation_ms;
@@ -272,24 +292,45 @@ LoadedFrame LoadAndSegment(const RgbdSource& dataset, const Settings& settings, 
 }
 
 // Camera-rate mode: offers the frames at their timestamps (relative to the first one's, from
-// now) into `camera`, which holds one frame; a frame not taken before the next arrives is
-// dropped (its index appended to *dropped). Frames are read ahead of their arrival. Returns the
-// number offered.
+// the camera's start) into `camera`, which holds one frame; a frame not taken before the next
+// arrives is dropped (its index appended to *dropped). A camera delivers decoded images: the
+// first frames, up to options.camera_preload_mb of decoded images, are read and decoded before
+// the camera starts (*camera_start); the frames after those are read on time, in this thread.
+// Returns the number offered.
 size_t OfferAtCameraRate(const RgbdSource& dataset, const Settings& settings, size_t n,
                          const RunOptions& options, BoundedQueue<LoadedFrame>* camera,
-                         std::vector<int64_t>* dropped) {
+                         std::vector<int64_t>* dropped,
+                         std::chrono::steady_clock::time_point* camera_start) {
   using Clock = std::chrono::steady_clock;
-  const Clock::time_point start = Clock::now();
+  std::deque<LoadedFrame> preloaded;
+  const double budget = static_cast<double>(options.camera_preload_mb) * 1024 * 1024;
+  double bytes = 0;
+  while (preloaded.size() < n && bytes < budget && !StopRequested(options)) {
+    preloaded.push_back(LoadFrame(dataset, settings, preloaded.size()));
+    const RgbdImages& im = preloaded.back().images;
+    bytes += static_cast<double>(im.bgr.total() * im.bgr.elemSize() + im.gray.total() * im.gray.elemSize() +
+                                 im.depth_m.total() * im.depth_m.elemSize()) + 1024;
+  }
+  const size_t preloaded_frames = preloaded.size();
+  const Clock::time_point start = *camera_start = Clock::now();
   const double first = n > 0 ? dataset.stamp(0).Seconds() : 0.0;
   Clock::time_point previous = start;
   size_t offered = 0;
   for (size_t i = 0; i < n && !StopRequested(options); ++i) {
-    LoadedFrame f = LoadFrame(dataset, settings, i);
+    LoadedFrame f;
+    if (i < preloaded_frames) {
+      f = std::move(preloaded.front());
+      preloaded.pop_front();
+    } else {
+      f = LoadFrame(dataset, settings, i);
+    }
     const double after = std::max(0.0, dataset.stamp(i).Seconds() - first);
     const Clock::time_point due = std::max(
-        previous, start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(after)));
+        previous,
+        start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(after)));
     // In steps, so that a stop is seen within 20 ms.
-    for (Clock::time_point now = Clock::now(); now < due && !StopRequested(options); now = Clock::now())
+    for (Clock::time_point now = Clock::now(); now < due && !StopRequested(options);
+         now = Clock::now())
       std::this_thread::sleep_until(std::min(due, now + std::chrono::milliseconds(20)));
     f.arrival = previous = std::max(due, Clock::now());
     std::optional<LoadedFrame> old;
@@ -333,8 +374,10 @@ RunSummary Finish(RunRecorder& recorder, const RgbdSource& dataset, const Settin
 Frame Extract(const SlamSystem& slam, const RgbdSource& dataset, const LoadedFrame& f,
               FrameReport* report) {
   report->segmentation_ms = f.segmentation_ms;
-  return slam.ExtractFrame(f.index, dataset.stamp(static_cast<size_t>(f.index)),
-                           f.images.gray, f.images.depth_m, cv::Mat(), report,
+  report->mask_source = f.mask_source;
+  report->mask_age = f.mask_age;
+  return slam.ExtractFrame(f.index, dataset.stamp(static_cast<size_t>(f.index)), f.images.gray,
+                           f.images.depth_m, cv::Mat(), report,
                            f.segmented ? &f.instances : nullptr);
 }
 
@@ -372,8 +415,8 @@ RunSummary RunSequential(const RgbdSource& dataset, const Settings& settings,
                            loaded.images.depth_m);
     if (kf != kNoKeyFrame) slam.MapKeyFrame(kf, &report);
     recorder.Add(report);
-    Observe(observer, slam, report, &loaded.images.bgr, loaded.segmented ? &loaded.instances : nullptr,
-            &tracked);
+    Observe(observer, slam, report, &loaded.images.bgr,
+            loaded.segmented ? &loaded.instances : nullptr, &tracked);
   }
   return Finish(recorder, dataset, settings, options, slam, start, segmenter);
 }
@@ -395,7 +438,7 @@ RunSummary RunThreaded(const RgbdSource& dataset, const Settings& settings,
     std::vector<Instance> instances;  // for the keyframe masks
     bool segmented = false;
     cv::Mat depth_m;
-    cv::Mat bgr;  // for the observer (only with one)
+    cv::Mat bgr;                                    // for the observer (only with one)
     std::chrono::steady_clock::time_point arrival;  // camera-rate mode
   };
   RunObserver* observer = options.observer;
@@ -406,44 +449,96 @@ RunSummary RunThreaded(const RgbdSource& dataset, const Settings& settings,
   BoundedQueue<LoadedFrame> loaded(capacity);
   BoundedQueue<Extracted> extracted(capacity);
   BoundedQueue<KeyFrameId> keyframes(8);
+  // Asynchronous segmentation: the newest frame for the segmentation thread, and its results.
+  const bool async = options.realtime && options.async_segmentation && segmenter != nullptr;
+  BoundedQueue<LoadedFrame> to_segment(1);
+  MaskCarrier carrier(options.slam.dynamic.propagation);
+  std::vector<double> detection_ms;  // the segmentation thread's until Join
   const auto close_queues = [&] {
     camera.Close();
     loaded.Close();
     extracted.Close();
     keyframes.Close();
+    to_segment.Close();
+    carrier.Close();
   };
   StageThreads stages(close_queues);
   // A stop drops the frames and keyframes still queued: every stage ends after its current item.
   const StopWatcher watcher(options, &slam, close_queues);
   size_t offered = 0;
   std::vector<int64_t> dropped;  // the camera thread's until Join
+  std::chrono::steady_clock::time_point camera_start = start;  // the camera thread's until Join
+  if (options.realtime && segmenter != nullptr && n > 0) {
+    // As a live system would before opening the camera: the networks' first call (allocating
+    // their layers) is several times slower than the next ones. The result is not used.
+    const LoadedFrame first = LoadFrame(dataset, settings, 0);
+    if (first.unreadable.empty()) segmenter->WarmUp(SegmentationInput(dataset, first));
+  }
   if (options.realtime) {
     stages.Start(
-        "camera", [&] { offered = OfferAtCameraRate(dataset, settings, n, options, &camera, &dropped); },
+                "camera",
+        [&] {
+          offered = OfferAtCameraRate(dataset, settings, n, options, &camera, &dropped, &camera_start);
+        },
         [&] { camera.Close(); });
   }
-  stages.Start(
-      options.realtime ? "segmentation" : "loading",
-      [&] {
-        if (options.realtime) {
-          while (std::optional<LoadedFrame> f = camera.Pop()) {
+  if (async) {
+    stages.Start(
+        "segmentation",
+        [&] {
+          while (std::optional<LoadedFrame> f = to_segment.Pop()) {
             if (StopRequested(options)) break;
-            Segment(dataset, &slam, &*f);
-            if (!loaded.Push(std::move(*f))) break;
+            FrameInstances d = slam.DetectFrame(SegmentationInput(dataset, *f));
+            detection_ms.push_back(d.segmentation_ms);
+            carrier.Publish(f->index, f->images.gray, std::move(d.instances));
           }
-          return;
-        }
-        for (size_t i = 0; i < n && !StopRequested(options); ++i) {
-          if (!loaded.Push(LoadAndSegment(dataset, settings, i, &slam))) break;
-        }
-      },
-      [&] { loaded.Close(); });
+        },
+        [&] { carrier.Close(); });  // no frame waits for masks that will not come
+  } else {
+    stages.Start(
+        options.realtime ? "segmentation" : "loading",
+        [&] {
+          if (options.realtime) {
+            while (std::optional<LoadedFrame> f = camera.Pop()) {
+              if (StopRequested(options)) break;
+              Segment(dataset, &slam, &*f);
+              if (!loaded.Push(std::move(*f))) break;
+            }
+            return;
+          }
+          for (size_t i = 0; i < n && !StopRequested(options); ++i) {
+            if (!loaded.Push(LoadAndSegment(dataset, settings, i, &slam))) break;
+          }
+        },
+        [&] { loaded.Close(); });
+  }
+  // Asynchronous segmentation: hands the frame to the segmentation thread (replacing a frame it
+  // has not taken yet) and gives the frame the newest masks carried to it. The first frame waits
+  // for its own.
+  bool waited_for_first_masks = false;
+  const auto carry_masks = [&](LoadedFrame* f) {
+    std::optional<LoadedFrame> replaced;
+    to_segment.PushDroppingOldest(*f, &replaced);
+    if (!waited_for_first_masks) {
+      carrier.WaitFor(f->index);
+      waited_for_first_masks = true;
+    }
+    std::optional<CarriedInstances> c = carrier.Carry(f->index, f->images.gray);
+    if (!c) return;  // the segmentation thread stopped before publishing anything
+    f->instances = std::move(c->instances);
+    f->segmented = true;
+    f->segmentation_ms = c->carry_ms;
+    f->mask_source = c->source;
+    f->mask_age = c->age;
+  };
+  BoundedQueue<LoadedFrame>& extraction_input = async ? camera : loaded;
   stages.Start(
       "extraction",
       [&] {
-        while (std::optional<LoadedFrame> f = loaded.Pop()) {
+        while (std::optional<LoadedFrame> f = extraction_input.Pop()) {
           if (StopRequested(options)) break;
           Extracted e;
+          if (async && f->unreadable.empty()) carry_masks(&*f);
           if (!f->unreadable.empty()) {
             e.report = SkippedReport(dataset, *f);
           } else {
@@ -457,7 +552,10 @@ RunSummary RunThreaded(const RgbdSource& dataset, const Settings& settings,
           if (!extracted.Push(std::move(e))) break;
         }
       },
-      [&] { extracted.Close(); });
+      [&] {
+        extracted.Close();
+        to_segment.Close();
+      });
   if (options.mapping_thread) {
     stages.Start("local mapping", [&] {
       while (std::optional<KeyFrameId> kf = keyframes.Pop()) {
@@ -501,7 +599,11 @@ RunSummary RunThreaded(const RgbdSource& dataset, const Settings& settings,
       },
       [&] { keyframes.Close(); });
   stages.Join();
-  if (options.realtime) recorder.SetCamera(offered, std::move(dropped));
+  if (options.realtime) {
+    recorder.SetCamera(offered, std::move(dropped),
+                       std::chrono::duration<double>(std::chrono::steady_clock::now() - camera_start).count());
+  }
+  if (async) recorder.SetAsyncSegmentation(detection_ms);
   return Finish(recorder, dataset, settings, options, slam, start, segmenter);
 }
 

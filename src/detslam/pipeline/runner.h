@@ -31,6 +31,17 @@ struct RunOptions {
   // (RunSummary::dropped_frames). The queues between the stages then hold one frame each, and each
   // processed frame's latency from its arrival to its pose goes into FrameReport::latency_ms.
   bool realtime = false;
+  // Camera-rate mode with a segmenter: asynchronous segmentation. The segmentation thread takes
+  // the newest frame whenever it is free and publishes its instances; no other stage waits for it:
+  // each frame uses the newest instances carried to it by the mask propagation (MaskCarrier), with
+  // their age in FrameReport::mask_age, and a frame whose masks are older than
+  // slam.dynamic.keyframe_max_mask_age makes no keyframe. Only the first frame waits for its own
+  // masks (the map's first points). false: every processed frame is segmented before extraction.
+  bool async_segmentation = true;
+  // Camera-rate mode: the first frames, up to this many MiB of decoded images, are read and
+  // decoded before the camera starts (a camera delivers decoded images; decoding PNG files would
+  // take CPU time a live camera does not); later frames are read on time by the camera thread.
+  size_t camera_preload_mb = 2048;
   std::string save_map;         // write the final map to this map file (empty: none)
   std::string load_map;         // start from the map in this map file (empty: a new map)
   // The dense static map (dense/dense_fusion.h): after the run, the main map's keyframes are fused
@@ -81,8 +92,17 @@ struct RunSummary {
   // the frames processed (ms; also its 99th percentile).
   size_t offered = 0;
   std::vector<int64_t> dropped_frames;
+  double camera_s = 0;  // from the camera's start (after preloading) to the last frame's end
+  double ProcessedFps() const { return camera_s > 0 ? frames / camera_s : 0.0; }
   ErrorStats latency;
   double latency_p99_ms = 0;
+  // Asynchronous segmentation (RunOptions::async_segmentation): frames the segmentation thread
+  // segmented, the age of the masks each processed frame used (input frames), and the keyframes
+  // the tracker asked for that were not made because the masks were too old.
+  bool async_segmentation = false;
+  size_t frames_segmented = 0;
+  ErrorStats mask_age;
+  size_t keyframes_deferred = 0;
   size_t keyframe_masks = 0;  // written to out_dir/keyframe_masks
   DenseMapStats dense;        // of the dense map (dense_map)
   double wall_s = 0;
@@ -107,7 +127,9 @@ RunSummary RunSequential(const RgbdSource& dataset, const Settings& settings,
 // Threaded mode: a loader/segmentation thread feeds an extraction thread, which feeds the
 // tracking thread (the calling one), through bounded queues (closing a queue ends the stream);
 // with options.realtime a camera thread loads the frames and offers them at their timestamps to
-// the segmentation thread, dropping those it cannot take.
+// the segmentation thread, dropping those it cannot take; with options.async_segmentation too, the
+// camera feeds the extraction thread, which hands the newest frame to a segmentation thread that
+// nothing waits for (see RunOptions::async_segmentation).
 // With options.mapping_thread, local mapping runs in a fourth thread fed by a keyframe queue
 // (results then depend on timing); without it, mapping runs in the tracking thread and the
 // trajectory equals the sequential one. An exception in any stage stops the others and is

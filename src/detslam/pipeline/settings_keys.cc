@@ -121,6 +121,7 @@ std::vector<Binding> MakeBindings() {
   k.push_back(Key("Dynamic.GeometricMinResidual", 0, kInf, "floor on the geometric check threshold (pixels)", [](auto& r) -> auto& { return r.run.slam.dynamic.geometric.threshold.min_threshold; }));
   // Segmentation.
   k.push_back(Key("Segmentation.EveryK", 1, kInf, "segment every K-th frame; masks follow the optical flow in between (--segment-every)", [](auto& r) -> auto& { return r.run.slam.dynamic.segment_every; }));
+  k.push_back(Key("Segmentation.KeyFrameMaxMaskAge", 0, kInf, "camera-rate mode (asynchronous segmentation): a frame whose masks were segmented more than this many input frames earlier makes no keyframe", [](auto& r) -> auto& { return r.run.slam.dynamic.keyframe_max_mask_age; }));
   k.push_back(Key("Segmentation.Detector", "dnn: first detector, .onnx (YOLOX) or Darknet .cfg (relative: models folder)", [](auto& r) -> auto& { return r.segmenter.detector; }));
   k.push_back(Key("Segmentation.Weights", "dnn: Darknet weights (empty: beside the detector)", [](auto& r) -> auto& { return r.segmenter.weights; }));
   k.push_back(Key("Segmentation.Names", "dnn: class names file (empty: coco.names beside the detector)", [](auto& r) -> auto& { return r.segmenter.names; }));

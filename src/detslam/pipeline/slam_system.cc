@@ -214,6 +214,10 @@ FrameInstances SlamSystem::SegmentFrame(const SegmenterInput& input, const cv::M
   return dynamic_.Segment(input, gray);
 }
 
+FrameInstances SlamSystem::DetectFrame(const SegmenterInput& input) {
+  return dynamic_.Detect(input);
+}
+
 Frame SlamSystem::ExtractFrame(int64_t index, Timestamp stamp, const cv::Mat& gray,
                                const cv::Mat& depth_m, const cv::Mat& ignore_mask,
                                FrameReport* report, const std::vector<Instance>* instances) const {
@@ -265,8 +269,14 @@ KeyFrameId SlamSystem::TrackFrame(Frame frame, FrameReport* report, Frame* track
   const size_t kfs_before = map.NumKeyFrames();
   report->tracking = tracker_.Track(map, &frame);
   KeyFrameId new_kf = kNoKeyFrame;
-  if (report->tracking.pose_valid && report->tracking.need_keyframe && !options_.localization)
-    new_kf = tracker_.CreateKeyFrame(map, &frame);
+  if (report->tracking.pose_valid && report->tracking.need_keyframe && !options_.localization) {
+    // Asynchronous segmentation: no new map points from masks carried over too many frames.
+    if (report->mask_age > options_.dynamic.keyframe_max_mask_age) {
+      report->keyframe_deferred = true;
+    } else {
+      new_kf = tracker_.CreateKeyFrame(map, &frame);
+    }
+  }
   if (map.NumKeyFrames() > kfs_before && new_kf == kNoKeyFrame)
     new_kf = tracker_.reference_keyframe();
   report->timings.tracking_ms = MsSince(t0);

@@ -75,7 +75,15 @@ struct FrameReport {
   int64_t index = 0;
   int dynamic_instances = 0;   // dynamic instances the filter used
   int rejected_keypoints = 0;  // keypoints rejected by the dynamic filter (after extraction)
-  double segmentation_ms = 0;  // time of the segmenter for this frame
+  double segmentation_ms = 0;  // time of the segmenter for this frame (asynchronous: of carrying
+                               // the newest masks to it)
+  // Asynchronous segmentation: the input frame whose segmentation this frame's masks come from,
+  // and their age in input frames (0: its own); -1 when not asynchronous or no masks yet.
+  int64_t mask_source = -1;
+  int mask_age = -1;
+  // The tracker asked for a keyframe but the frame's masks were older than
+  // DetSlamOptions::keyframe_max_mask_age: no keyframe was made from it.
+  bool keyframe_deferred = false;
   Timestamp stamp;
   TrackingResult tracking;
   bool keyframe = false;
@@ -130,6 +138,9 @@ class SlamSystem {
   // Loading stage (frames in input order): the frame's dynamic instances from the Det-SLAM stage
   // (segmenter, instance memory, mask propagation). Not segmented without a segmenter.
   FrameInstances SegmentFrame(const SegmenterInput& input, const cv::Mat& gray);
+  // Asynchronous segmentation's thread: the segmenter (and instance memory) on one frame, without
+  // mask propagation (DetSlamStage::Detect).
+  FrameInstances DetectFrame(const SegmenterInput& input);
   // Feature extraction stage: thread-safe (const), may run ahead of tracking in another thread.
   // With `instances` (from SegmentFrame), the Det-SLAM stage labels keypoints on dynamic objects:
   // they are moved to the frame's rejected list (labelled) and never reach tracking. Fills

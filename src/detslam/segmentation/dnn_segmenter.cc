@@ -365,3 +365,22 @@ std::vector<Instance> DnnSegmenter::Segment(const SegmenterInput& input) {
 }
 
 }  // namespace detslam
+
+namespace detslam {
+
+void DnnSegmenter::WarmUp(const SegmenterInput& input) {
+  const int64_t calls = calls_;
+  calls_ = 0;  // the second detector runs too
+  const std::vector<Instance> found = Segment(input);
+  const bool person = std::any_of(found.begin(), found.end(),
+                                  [](const Instance& i) { return i.class_id == 0; });
+  if (person_mask_ && !person && !input.bgr.empty()) {
+    const cv::Size size = input.bgr.size();
+    person_mask_->Mask(input.bgr, cv::Rect(size.width / 4, size.height / 4, size.width / 2, size.height / 2));
+  }
+  calls_ = calls;
+  second_last_.clear();
+  timings_ = DnnTimings();
+}
+
+}  // namespace detslam

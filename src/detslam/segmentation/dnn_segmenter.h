@@ -82,6 +82,9 @@ class DnnSegmenter : public Segmenter {
 
   std::vector<Instance> Segment(const SegmenterInput& input) override;
   std::string name() const override { return name_; }
+  // Both detectors and the person mask model once on `input` (the mask model on a box in the
+  // middle when no person is found); the call counter and the second detector's boxes are reset.
+  void WarmUp(const SegmenterInput& input) override;
   const DnnTimings& last_timings() const { return timings_; }
   // Class names of the first detector.
   const std::vector<std::string>& class_names() const;

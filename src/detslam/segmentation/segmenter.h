@@ -34,6 +34,10 @@ class Segmenter {
   // classes count as dynamic). Throws InputError for unreadable inputs named in the message.
   virtual std::vector<Instance> Segment(const SegmenterInput& input) = 0;
   virtual std::string name() const = 0;
+  // Runs the backend once on `input` and forgets the result and any state it left (e.g. a network
+  // that allocates its layers on the first call), so that the first real frame is not slower than
+  // the others. Default: nothing to warm up.
+  virtual void WarmUp(const SegmenterInput& input) { (void)input; }
 };
 
 }  // namespace detslam
