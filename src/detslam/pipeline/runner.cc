@@ -486,6 +486,7 @@ RunSummary RunThreaded(const RgbdSource& dataset, const Settings& settings,
     stages.Start(
         "segmentation",
         [&] {
+          LowerThisThreadPriority(options.background_nice);  // async segmentation runs only at camera rate
           while (std::optional<LoadedFrame> f = to_segment.Pop()) {
             if (StopRequested(options)) break;
             FrameInstances d = slam.DetectFrame(SegmentationInput(dataset, *f));
@@ -558,6 +559,7 @@ RunSummary RunThreaded(const RgbdSource& dataset, const Settings& settings,
       });
   if (options.mapping_thread) {
     stages.Start("local mapping", [&] {
+      if (options.realtime) LowerThisThreadPriority(options.background_nice);
       while (std::optional<KeyFrameId> kf = keyframes.Pop()) {
         if (StopRequested(options)) break;  // the keyframe stays in the map, not locally mapped
         FrameReport unused;

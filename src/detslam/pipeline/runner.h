@@ -42,6 +42,11 @@ struct RunOptions {
   // decoded before the camera starts (a camera delivers decoded images; decoding PNG files would
   // take CPU time a live camera does not); later frames are read on time by the camera thread.
   size_t camera_preload_mb = 2048;
+  // Camera-rate mode: the asynchronous segmentation thread and the local-mapping thread (and the
+  // global bundle adjustment it starts) run at this nice value (Linux; 0 = the frame path's), so
+  // that when the cores are busy the frames' path (camera, extraction, tracking) gets them first.
+  // 5 was chosen on walking_xyz tuning seeds 1-3 (docs/BENCHMARKS.md, section realtime).
+  int background_nice = 5;
   std::string save_map;         // write the final map to this map file (empty: none)
   std::string load_map;         // start from the map in this map file (empty: a new map)
   // The dense static map (dense/dense_fusion.h): after the run, the main map's keyframes are fused

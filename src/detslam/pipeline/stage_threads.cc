@@ -1,8 +1,24 @@
 #include "detslam/pipeline/stage_threads.h"
 
+#if defined(__linux__)
+#include <sys/resource.h>
+#include <sys/syscall.h>
+#include <unistd.h>
+#endif
+
 #include <spdlog/spdlog.h>
 
 namespace detslam {
+
+bool LowerThisThreadPriority(int nice) {
+#if defined(__linux__)
+  const auto tid = static_cast<id_t>(syscall(SYS_gettid));
+  return setpriority(PRIO_PROCESS, tid, nice) == 0;
+#else
+  (void)nice;
+  return false;
+#endif
+}
 
 StageThreads::StageThreads(std::function<void()> stop) : stop_(std::move(stop)) {}
 

@@ -14,6 +14,10 @@
 
 namespace detslam {
 
+// Lowers the calling thread's scheduling priority to `nice` (Linux: its nice value, 0..19; threads
+// it starts later inherit it). Returns false where that is not possible (then nothing changes).
+bool LowerThisThreadPriority(int nice);
+
 class StageThreads {
  public:
   explicit StageThreads(std::function<void()> stop);

@@ -4,6 +4,13 @@
 
 #include <atomic>
 #include <stdexcept>
+#include <thread>
+
+#if defined(__linux__)
+#include <sys/resource.h>
+#include <sys/syscall.h>
+#include <unistd.h>
+#endif
 
 #include "detslam/pipeline/bounded_queue.h"
 
@@ -67,6 +74,28 @@ TEST(StageThreads, TheFirstErrorWins) {
     EXPECT_STREQ(e.what(), "first");
   }
 }
+
+#if defined(__linux__)
+// The nice value of the calling thread only (not the process's other threads), inherited by the
+// threads it starts.
+TEST(StageThreads, LowerThisThreadPriorityChangesTheCallingThreadOnly) {
+  const auto nice_of_this_thread = [] {
+    return getpriority(PRIO_PROCESS, static_cast<id_t>(syscall(SYS_gettid)));
+  };
+  const int before = nice_of_this_thread();
+  int lowered = -100, child = -100;
+  std::thread t([&] {
+    ASSERT_TRUE(LowerThisThreadPriority(before + 3));
+    lowered = nice_of_this_thread();
+    std::thread grandchild([&] { child = nice_of_this_thread(); });
+    grandchild.join();
+  });
+  t.join();
+  EXPECT_EQ(lowered, before + 3);
+  EXPECT_EQ(child, before + 3);
+  EXPECT_EQ(nice_of_this_thread(), before);
+}
+#endif
 
 }  // namespace
 }  // namespace detslam
