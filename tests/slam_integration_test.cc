@@ -194,6 +194,22 @@ class SlowSegmenter : public Segmenter {
   int ms_;
 };
 
+// 60 frames of a static 30 fps sequence at camera rate (threaded, mapping thread), with a segmenter
+// that takes `segmenter_ms` per frame; *options: those of the run.
+RunSummary RunAtCameraRate(const std::string& name, bool async, int segmenter_ms, RunOptions* options) {
+  const std::string seq = WriteStaticSequence(name, 1, 60);
+  const RgbdDataset dataset = RgbdDataset::Open(seq, {});
+  const Settings settings = PresetForDataset(seq);
+  options->out_dir = TempDir(name + "_run");
+  options->threaded = true;
+  options->mapping_thread = true;
+  options->realtime = true;
+  options->async_segmentation = async;
+  options->slam = SlamOptionsFromSettings(settings, 42);
+  SlowSegmenter segmenter(segmenter_ms);
+  return detslam::Run(dataset, settings, *options, nullptr, &segmenter);
+}
+
 // Every offered frame is either processed (in order) or dropped, never both.
 void ExpectEveryFrameProcessedOrDropped(const RunSummary& s, int64_t offered) {
   std::vector<int64_t> all = s.dropped_frames;
@@ -216,18 +232,8 @@ void ExpectEveryFrameProcessedOrDropped(const RunSummary& s, int64_t offered) {
 // is either processed or dropped, the processed ones in order, and latency stays bounded (queued
 // frames would wait up to 4 s by the end).
 TEST(IntegrationRunner, CameraRateDropsTheFramesThePipelineCannotTake) {
-  const std::string seq = WriteStaticSequence("camera_rate", 1, 60);
-  const RgbdDataset dataset = RgbdDataset::Open(seq, {});
-  const Settings settings = PresetForDataset(seq);
   RunOptions options;
-  options.out_dir = TempDir("camera_rate_run");
-  options.threaded = true;
-  options.mapping_thread = true;
-  options.realtime = true;
-  options.async_segmentation = false;
-  options.slam = SlamOptionsFromSettings(settings, 42);
-  SlowSegmenter segmenter(100);
-  const RunSummary s = detslam::Run(dataset, settings, options, nullptr, &segmenter);
+  const RunSummary s = RunAtCameraRate("camera_rate", /*async=*/false, 100, &options);
   EXPECT_EQ(s.offered, 60u);
   EXPECT_EQ(s.frames + s.dropped_frames.size(), 60u);
   EXPECT_GE(s.dropped_frames.size(), 30u) << "frames were queued, not dropped";
@@ -256,15 +262,6 @@ TEST(IntegrationRunner, CameraRateDropsTheFramesThePipelineCannotTake) {
 // segmenter's time (except the first frame's, which waits for its own masks), and every frame
 // knows which frame its masks come from and their age.
 TEST(IntegrationRunner, AsynchronousSegmentationDoesNotHoldTheFramesUp) {
-  const std::string seq = WriteStaticSequence("camera_rate_async", 1, 60);
-  const RgbdDataset dataset = RgbdDataset::Open(seq, {});
-  const Settings settings = PresetForDataset(seq);
-  RunOptions options;
-  options.out_dir = TempDir("camera_rate_async_run");
-  options.threaded = true;
-  options.mapping_thread = true;
-  options.realtime = true;
-  options.slam = SlamOptionsFromSettings(settings, 42);
   // Sanitized builds run extraction and tracking 5-20x slower: a slower segmenter keeps the test
   // about the same thing there.
 #if defined(__SANITIZE_THREAD__) || defined(__SANITIZE_ADDRESS__)
@@ -272,8 +269,8 @@ TEST(IntegrationRunner, AsynchronousSegmentationDoesNotHoldTheFramesUp) {
 #else
   constexpr int kSegmenterMs = 100;
 #endif
-  SlowSegmenter segmenter(kSegmenterMs);
-  const RunSummary s = detslam::Run(dataset, settings, options, nullptr, &segmenter);
+  RunOptions options;
+  const RunSummary s = RunAtCameraRate("camera_rate_async", /*async=*/true, kSegmenterMs, &options);
   EXPECT_TRUE(s.async_segmentation);
   EXPECT_EQ(s.offered, 60u);
   ExpectEveryFrameProcessedOrDropped(s, 60);
