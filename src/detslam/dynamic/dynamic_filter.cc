@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "detslam/core/check.h"
+#include "detslam/dynamic/ellipse_dilate.h"
 
 namespace detslam {
 namespace {
@@ -79,12 +80,7 @@ InstanceRegion BuildRegion(const Instance& instance, const cv::Mat& depth_m,
   } else {
     cv::compare(instance.mask(region.roi), 0, local, cv::CMP_GT);
   }
-  if (r > 0) {
-    const cv::Mat kernel =
-        cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * r + 1, 2 * r + 1));
-    cv::dilate(local, local, kernel);
-  }
-  region.dilated = local;
+  region.dilated = r > 0 ? DilateEllipse(local, r) : local;
   if (options.depth_step && !depth_m.empty()) {
     region.interval = ObjectDepthInterval(depth_m, instance.mask, instance.box, options);
   }

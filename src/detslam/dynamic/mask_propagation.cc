@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "detslam/core/check.h"
+#include "detslam/dynamic/ellipse_dilate.h"
 
 namespace detslam {
 namespace {
@@ -18,10 +19,7 @@ double MedianOf(std::vector<float> v) {
 
 cv::Mat Grow(const cv::Mat& mask, int px) {
   if (mask.empty() || px <= 0) return mask;
-  cv::Mat out;
-  cv::dilate(mask, out,
-             cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * px + 1, 2 * px + 1)));
-  return out;
+  return DilateEllipse(mask, px);
 }
 
 }  // namespace

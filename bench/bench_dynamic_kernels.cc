@@ -1,0 +1,81 @@
+// Kernels of the Det-SLAM stage that run on every frame (Google Benchmark, single thread): mask
+// dilation by the elliptic kernel (DilateEllipse against cv::dilate, on a person-sized mask and on
+// a full-frame mask as the mask propagation grows it), and carrying masks to a later frame
+// (MaskCarrier: optical flow + growth). Synthetic 640x480 images; no data needed.
+#include <benchmark/benchmark.h>
+
+#include <opencv2/core/utility.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "detslam/dynamic/ellipse_dilate.h"
+#include "detslam/dynamic/mask_carrier.h"
+
+namespace {
+
+// A person-like blob (ellipse body + circle head) in a 640x480 mask.
+cv::Mat PersonMask(int dx = 0) {
+  cv::Mat mask = cv::Mat::zeros(480, 640, CV_8UC1);
+  cv::ellipse(mask, {300 + dx, 300}, {70, 160}, 0, 0, 360, cv::Scalar(255), cv::FILLED);
+  cv::circle(mask, {300 + dx, 120}, 40, cv::Scalar(255), cv::FILLED);
+  return mask;
+}
+
+// Textured 640x480 grey image with the person (its own texture, moved with it) shifted by dx.
+cv::Mat Frame(int dx) {
+  cv::Mat background(480, 640, CV_8UC1), person(480, 640, CV_8UC1);
+  cv::RNG(3).fill(background, cv::RNG::UNIFORM, 0, 120);
+  cv::RNG(4).fill(person, cv::RNG::UNIFORM, 120, 255);
+  cv::GaussianBlur(background, background, cv::Size(5, 5), 0);
+  cv::GaussianBlur(person, person, cv::Size(5, 5), 0);
+  cv::Mat moved;
+  const cv::Mat shift = (cv::Mat_<double>(2, 3) << 1, 0, dx, 0, 1, 0);
+  cv::warpAffine(person, moved, shift, person.size());
+  moved.copyTo(background, PersonMask(dx));
+  return background;
+}
+
+void BM_DilateOpenCvEllipse(benchmark::State& state) {
+  cv::setNumThreads(1);
+  const int r = static_cast<int>(state.range(0));
+  const cv::Mat mask = PersonMask();
+  const cv::Mat kernel = cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * r + 1, 2 * r + 1));
+  cv::Mat out;
+  for (auto _ : state) {
+    cv::dilate(mask, out, kernel);
+    benchmark::DoNotOptimize(out.data);
+  }
+}
+BENCHMARK(BM_DilateOpenCvEllipse)->Arg(6)->Arg(15)->Arg(24)->Unit(benchmark::kMillisecond);
+
+void BM_DilateEllipse(benchmark::State& state) {
+  cv::setNumThreads(1);
+  const int r = static_cast<int>(state.range(0));
+  const cv::Mat mask = PersonMask();
+  for (auto _ : state) {
+    cv::Mat out = detslam::DilateEllipse(mask, r);
+    benchmark::DoNotOptimize(out.data);
+  }
+}
+BENCHMARK(BM_DilateEllipse)->Arg(6)->Arg(15)->Arg(24)->Unit(benchmark::kMillisecond);
+
+// One segmentation published for frame 0, carried to frame `age` (the person moved 4 px a frame).
+void BM_MaskCarry(benchmark::State& state) {
+  cv::setNumThreads(1);
+  const int age = static_cast<int>(state.range(0));
+  const cv::Mat source = Frame(0), target = Frame(4 * age);
+  detslam::Instance person;
+  person.class_name = "person";
+  person.mask = PersonMask();
+  person.box = cv::boundingRect(person.mask);
+  for (auto _ : state) {
+    detslam::MaskCarrier carrier;
+    carrier.Publish(0, source, {person});
+    auto carried = carrier.Carry(age, target);
+    benchmark::DoNotOptimize(carried);
+  }
+}
+BENCHMARK(BM_MaskCarry)->Arg(1)->Arg(6)->Arg(12)->Unit(benchmark::kMillisecond);
+
+}  // namespace
+
+BENCHMARK_MAIN();
