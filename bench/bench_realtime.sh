@@ -183,3 +183,4 @@ PY
   publish realtime-tracking "$work/tracking.md"
 fi
 
+python3 "$here/readme_summary.py"
