@@ -44,6 +44,11 @@ def tables(body):
     return out
 
 
+def table_with(body, column):
+    """The first table of a section that has `column`, as tables() gives it (empty if none)."""
+    return next((t for t in tables(body) if t and column in t[0]), [])
+
+
 def number(cell):
     m = re.match(r"[-0-9.]+", cell)
     return float(m.group(0)) if m else float("nan")
@@ -75,7 +80,7 @@ def summary(bench_text):
                          f"ATE RMSE {r['ATE RMSE mm']} mm; end drift {drift.get(mode, '?')}"))
     dyn = section(bench_text, "dynamic")
     if dyn:
-        main = next((t for t in tables(dyn) if t and "ratio" in t[0]), [])
+        main = table_with(dyn, "ratio")
         by_preset = {}
         for r in main:
             by_preset.setdefault(r["preset"], []).append(r)
@@ -121,16 +126,14 @@ def summary(bench_text):
                          f"(worst {c[7]}x)"))
     files = section(bench_text, "atlas-files")
     if files:
-        table = next((t for t in tables(files) if t and "ATE / SLAM run of that path" in t[0]), [])
-        for r in table:
+        for r in table_with(files, "ATE / SLAM run of that path"):
             if "--load-map" in r["run"]:
                 rows.append((f"Map file (static, synthetic): {r['run']}",
                              f"{r['frames tracked']} tracked, {r['keyframes added']} keyframes added",
                              f"ATE RMSE {r['ATE RMSE mm']} mm, {r['ATE / SLAM run of that path']}x the SLAM run's"))
     dense = section(bench_text, "dense")
     if dense:
-        table = next((t for t in tables(dense) if t and "on people, filter %" in t[0]), [])
-        for r in table:
+        for r in table_with(dense, "on people, filter %"):
             rows.append((f"Dense static map (synthetic {r['preset']}, 3 evaluation seeds)",
                          f"{r['points (k)'].split()[0]}k points, completeness {r['completeness %'].split()[0]} %",
                          f"on people {r['on people, filter %']} % (no filter, no carving: "
@@ -151,8 +154,7 @@ def summary(bench_text):
                          f"live ATE {ratio}x the offline run's (worst {ratio_w}x)"))
     tracking = section(bench_text, "realtime-tracking")
     if tracking:
-        table = next((t for t in tables(tracking) if t and "segmenter" in t[0]), [])
-        for r in table:
+        for r in table_with(tracking, "segmenter"):
             if r["segmenter"] == "none":
                 rows.append(("Tracking + extraction per frame (real TUM fr2/desk clip, sequential, no segmenter)",
                              f"{r['frames tracked']} tracked",
