@@ -14,13 +14,14 @@ cv::Mat DilateEllipse(const cv::Mat& src, int radius) {
   if (radius == 0 || src.empty()) return src.clone();
   const int size = 2 * radius + 1;
   const cv::Mat kernel = cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(size, size));
-  // Below this radius OpenCV's own dilation is as fast (build/bench/detslam_bench_dynamic).
-  constexpr int kRowsFromRadius = 8;
-  if (radius < kRowsFromRadius) {
+  const auto opencv_dilate = [&] {
     cv::Mat dst;
     cv::dilate(src, dst, kernel);
     return dst;
-  }
+  };
+  // Below this radius OpenCV's own dilation is as fast (build/bench/detslam_bench_dynamic).
+  constexpr int kRowsFromRadius = 8;
+  if (radius < kRowsFromRadius) return opencv_dilate();
   // Half-width of each kernel row's run of ones (-1: an empty row).
   std::vector<int> half(static_cast<size_t>(size), -1);
   int widest = -1;
@@ -32,9 +33,7 @@ cv::Mat DilateEllipse(const cv::Mat& src, int radius) {
     // A run centred on the anchor: otherwise this decomposition does not hold.
     if (count % 2 != 1 || first != radius - count / 2 ||
         cv::countNonZero(kernel.row(j).colRange(first, first + count)) != count) {
-      cv::Mat dst;
-      cv::dilate(src, dst, kernel);
-      return dst;
+      return opencv_dilate();
     }
     half[static_cast<size_t>(j)] = count / 2;
     widest = std::max(widest, count / 2);

@@ -160,7 +160,7 @@ class RunRecorder {
     mask_recorder_.AddFrame(frame, keyframe, instances, depth_m);
   }
 
-  // Camera-rate mode: frames the camera offered and those it dropped.
+  // Camera-rate mode: frames the camera offered, those it dropped, and seconds from its start.
   void SetCamera(size_t offered, std::vector<int64_t> dropped, double camera_s) {
     summary_.offered = offered;
     summary_.dropped_frames = std::move(dropped);
@@ -476,7 +476,7 @@ RunSummary RunThreaded(const RgbdSource& dataset, const Settings& settings,
   }
   if (options.realtime) {
     stages.Start(
-                "camera",
+        "camera",
         [&] {
           offered = OfferAtCameraRate(dataset, settings, n, options, &camera, &dropped, &camera_start);
         },
