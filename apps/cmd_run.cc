@@ -39,6 +39,7 @@ struct RunArgs {
   bool threaded = false;
   bool realtime = false;  // --realtime: frames offered at their timestamps (implies threaded)
   bool sync_segmentation = false;  // --sync-segmentation: with --realtime, segment every frame taken
+  int camera_preload_mb = -1;      // --camera-preload-mb (-1: RunOptions' default)
   bool inline_mapping = false;
   std::string segmenter;  // empty: dnn if the models are found, else none
   std::string models;
@@ -137,6 +138,7 @@ void Run(RunArgs a) {
   options.threaded = a.threaded;
   options.realtime = a.realtime;
   options.async_segmentation = !a.sync_segmentation;
+  if (a.camera_preload_mb >= 0) options.camera_preload_mb = static_cast<size_t>(a.camera_preload_mb);
   options.slam = SlamOptionsFromSettings(settings, a.seed);
   options.mapping_thread = a.threaded && !a.inline_mapping;
   if (a.alpha >= 0) options.slam.dynamic.filter.alpha = a.alpha;
@@ -194,9 +196,10 @@ void Run(RunArgs a) {
                 s.ProcessedFps(), s.latency.median, s.latency_p99_ms);
     if (s.async_segmentation) {
       std::printf("asynchronous segmentation: %zu frames segmented; masks used %.1f frames old (median, max %.0f); "
-                  "%zu keyframes deferred for masks older than %d frames\n",
+                  "%zu keyframes deferred for masks older than %d frames, %zu made with such masks (tracking too weak to wait, or waited %d frames)\n",
                   s.frames_segmented, s.mask_age.median, s.mask_age.max, s.keyframes_deferred,
-                  options.slam.dynamic.keyframe_max_mask_age);
+                  options.slam.dynamic.keyframe_max_mask_age, s.keyframes_stale_masks,
+                  options.slam.dynamic.keyframe_max_wait);
     }
   }
   if (!s.segmenter.empty()) std::printf("segmentation (%s): median %.1f ms per frame\n", s.segmenter.c_str(), s.segmentation.median);
@@ -265,6 +268,9 @@ void AddRunCommand(CLI::App& app) {
                 "Camera rate: offer the frames at their timestamps as a live camera would (implies --threaded); a frame the pipeline has not taken when the next arrives is dropped, never queued; run.json reports the frames dropped and each frame's latency from arrival to pose");
   cmd->add_flag("--sync-segmentation", args->sync_segmentation,
                 "With --realtime: segment each frame taken before extracting it (the pipeline waits for the detector); default: asynchronous segmentation, each frame uses the newest masks carried to it by optical flow");
+  cmd->add_option("--camera-preload-mb", args->camera_preload_mb,
+                  "With --realtime: decode the first frames, up to this many MiB, before the camera starts (a camera delivers decoded images); later frames are read and decoded on time by the camera thread (default 2048; 0: every frame on time)")
+      ->check(CLI::NonNegativeNumber);
   cmd->add_flag("--inline-mapping", args->inline_mapping,
                 "With --threaded: local mapping in the tracking thread (then the trajectory equals the sequential one)");
   cmd->add_flag("--no-progress", args->no_progress, "No progress bar");

@@ -2,7 +2,7 @@
 """Writes the README's benchmark summary table from the measured tables in docs/BENCHMARKS.md.
 
 The numbers come only from the sections the benchmark commands wrote (slam, dynamic, atlas-cover,
-atlas-files, dense, realtime, realtime-tracking); this script
+atlas-files, dense, realtime, realtime-tracking, realtime-long); this script
 condenses them (per preset: seeds, frames tracked, ATE ratio to the static twin) and names the
 sections and their dates. The benchmark commands call it at the end; it can also be run alone.
 Usage: bench/readme_summary.py
@@ -160,10 +160,26 @@ def summary(bench_text):
                              f"{r['frames tracked']} tracked",
                              f"{r['extraction + tracking ms: mean']} ms median (worst run {r['worst']} ms; "
                              "ORB-SLAM3: 13-22 ms as the issue quotes it)"))
+    long_run = section(bench_text, "realtime-long")
+    if long_run:
+        runs = table_with(long_run, "frames offered")
+        cost = {r["per frame"]: r for r in table_with(long_run, "last / first")}
+        stall = re.search(r"no tracking stall longer than 2 frame periods while a loop is corrected: "
+                          r"(met|MISSED) \(([^)]*)\)", long_run)
+        growth = re.search(r"Growth per 1000 keyframes: ([0-9.]+) MiB", long_run)
+        if runs and "tracking ms, median" in cost:
+            r, c = runs[0], cost["tracking ms, median"]
+            rows.append((f"Long camera-rate run ({r['frames offered']} synthetic frames, loop_long lap repeated)",
+                         f"{r['processed frames tracked']} tracked, {r['dropped']} dropped",
+                         f"ATE {r['ATE mm']} mm; tracking {c['first 10 %']} -> {c['last 10 %']} ms median "
+                         f"(first / last 10 %: {c['last / first']}x)"
+                         + (f"; memory {growth.group(1)} MiB per 1000 keyframes" if growth else "")
+                         + (f"; loop correction stall {stall.group(2)}" if stall else "")))
     lines = ["| benchmark | frames | accuracy |", "|---|---|---|"]
     lines += [f"| {a} | {b} | {c} |" for a, b, c in rows]
     sources = []
-    for name in ("slam", "dynamic", "atlas-cover", "atlas-files", "dense", "realtime", "realtime-tracking"):
+    for name in ("slam", "dynamic", "atlas-cover", "atlas-files", "dense", "realtime", "realtime-tracking",
+                 "realtime-long"):
         body = section(bench_text, name)
         if body:
             sources.append(f"`{name}` ({stamp_date(body)})")

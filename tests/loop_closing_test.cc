@@ -60,6 +60,18 @@ std::vector<LoopRun> RunLoopPreset(const SyntheticSequence& seq,
     slam.WaitForGlobalBundleAdjustment();
     runs[i].loops = slam.loops_closed();
     EXPECT_EQ(slam.loops().size(), static_cast<size_t>(runs[i].loops));
+    for (const LoopRecord& loop : slam.loops()) {
+      // Mapping in line: the loop is corrected right after its keyframe's frame was tracked.
+      EXPECT_EQ(loop.corrected_after_frame, loop.frame);
+      EXPECT_GT(loop.map_locked_ms, 0.0);
+    }
+    // Every global BA that was not stopped by a newer loop applied its solution, after the loop.
+    const std::vector<int64_t> applied = slam.global_ba_applied_after_frames();
+    EXPECT_EQ(applied.size(),
+              static_cast<size_t>(slam.global_ba_runs() - slam.global_ba_stopped()));
+    if (!applied.empty() && !slam.loops().empty()) {
+      EXPECT_GE(applied.front(), slam.loops().front().frame);
+    }
     runs[i].ate_m = ComputeAte(gt, slam.FrameTrajectory(), AteOptions()).error_m.rmse;
   }
   return runs;

@@ -287,22 +287,34 @@ TEST(IntegrationRunner, AsynchronousSegmentationDoesNotHoldTheFramesUp) {
   EXPECT_EQ(s.reports.front().mask_age, 0) << "the first frame has its own masks";
   EXPECT_GE(s.reports.front().latency_ms, kSegmenterMs);
   int64_t previous_source = 0;
+  int64_t waiting_since = -1;  // the first deferred frame since the last keyframe
+  const DetSlamOptions& dyn = options.slam.dynamic;
   for (const FrameReport& r : s.reports) {
     EXPECT_GE(r.mask_source, previous_source) << "frame " << r.index << " used older masks";
     EXPECT_LE(r.mask_source, r.index);
     EXPECT_EQ(r.mask_age, r.index - r.mask_source);
     previous_source = r.mask_source;
     if (r.keyframe_deferred) {
-      EXPECT_GT(r.mask_age, options.slam.dynamic.keyframe_max_mask_age);
+      EXPECT_GT(r.mask_age, dyn.keyframe_max_mask_age);
+      EXPECT_GE(r.tracking.num_inliers, dyn.keyframe_defer_min_inliers);
+      if (waiting_since < 0) waiting_since = r.index;
+      EXPECT_LT(r.index - waiting_since, dyn.keyframe_max_wait) << "frame " << r.index;
     }
     if (r.keyframe && r.tracking.method != "new map") {  // a new map starts whatever the masks
-      EXPECT_LE(r.mask_age, options.slam.dynamic.keyframe_max_mask_age) << "keyframe " << r.index;
+      // Masks at most the limit old, or stale ones after waiting keyframe_max_wait frames.
+      EXPECT_EQ(r.keyframe_stale_masks, r.mask_age > dyn.keyframe_max_mask_age) << r.index;
+      if (r.keyframe_stale_masks && r.tracking.num_inliers >= dyn.keyframe_defer_min_inliers) {
+        EXPECT_GE(waiting_since, 0) << "keyframe " << r.index << " made without waiting";
+        EXPECT_GE(r.index - waiting_since, dyn.keyframe_max_wait) << "keyframe " << r.index;
+      }
     }
+    if (r.keyframe) waiting_since = -1;
   }
   EXPECT_GT(s.mask_age.max, 0);
   const nlohmann::json j = nlohmann::json::parse(ReadFile((fs::path(options.out_dir) / "run.json").string()));
   EXPECT_EQ(j["realtime"]["asynchronous_segmentation"], true);
   EXPECT_EQ(j["realtime"]["frames_segmented"].get<size_t>(), s.frames_segmented);
+  EXPECT_EQ(j["realtime"]["keyframes_stale_masks"].get<size_t>(), s.keyframes_stale_masks);
   EXPECT_EQ(j["per_frame"][1]["mask_age"].get<int>(), s.reports[1].mask_age);
 }
 

@@ -21,8 +21,12 @@ bool DetSlamOptions::Check(std::string* error) const {
     if (error) *error = "mask propagation: " + e;
     return false;
   }
-  if (memory_frames < 0 || segment_every < 1 || keyframe_max_mask_age < 0) {
-    if (error) *error = "memory_frames must be >= 0, segment_every >= 1 and keyframe_max_mask_age >= 0";
+  if (memory_frames < 0 || segment_every < 1 || keyframe_max_mask_age < 0 ||
+      keyframe_max_wait < 0 || keyframe_defer_min_inliers < 0) {
+    if (error)
+      *error =
+          "memory_frames must be >= 0, segment_every >= 1, keyframe_max_mask_age >= 0 and "
+          "keyframe_max_wait and keyframe_defer_min_inliers >= 0";
     return false;
   }
   if (error) error->clear();

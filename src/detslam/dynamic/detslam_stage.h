@@ -33,6 +33,13 @@ struct DetSlamOptions {
   // more than this many input frames older does not become a keyframe (no new map points from
   // stale masks); the tracker asks again on the next frame. Frames with their own masks have age 0.
   int keyframe_max_mask_age = 6;  // chosen on walking_xyz tuning seeds 1-3 (bench_realtime.sh)
+  // ... but only while the frame tracks at least keyframe_defer_min_inliers map points (about 3x
+  // the 30 that make local-map tracking succeed), and at most keyframe_max_wait input frames after
+  // the first frame that asked for it: then the keyframe is made with the masks it has. A map
+  // starved of keyframes loses tracking: on loop_long (tuning seed 1), where the camera turns
+  // fast, the inliers fell from 86 to 34 over the 5 frames of a deferral and tracking failed.
+  int keyframe_defer_min_inliers = 100;
+  int keyframe_max_wait = 6;  // 0.2 s at 30 Hz
   MaskPropagationOptions propagation;  // how masks move between segmented frames
   MoverCheckOptions geometric;         // geometric check for movers the segmenter missed (tracker)
 

@@ -82,6 +82,10 @@ RunLog ReadRunLog(const std::string& path) {
     if (r.realtime.asynchronous) {
       r.realtime.frames_segmented = Get<int64_t>(t, "frames_segmented", path, "realtime: ");
       r.realtime.keyframes_deferred = Get<int64_t>(t, "keyframes_deferred", path, "realtime: ");
+      if (t.contains("keyframes_stale_masks")) {  // absent before Segmentation.KeyFrameMaxWait
+        r.realtime.keyframes_stale_masks =
+            Get<int64_t>(t, "keyframes_stale_masks", path, "realtime: ");
+      }
       const json age = Get<json>(t, "mask_age_frames", path, "realtime: ");
       r.realtime.mask_age_median = Get<double>(age, "median", path, "realtime.mask_age_frames: ");
       r.realtime.mask_age_max = Get<double>(age, "max", path, "realtime.mask_age_frames: ");

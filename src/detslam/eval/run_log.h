@@ -45,6 +45,7 @@ struct RunRealtimeLog {
   // Asynchronous segmentation (absent in older files and with --sync-segmentation: false).
   bool asynchronous = false;
   int64_t frames_segmented = 0, keyframes_deferred = 0;
+  int64_t keyframes_stale_masks = 0;  // made with stale masks after waiting for fresh ones
   double mask_age_median = 0, mask_age_max = 0;  // input frames
 };
 

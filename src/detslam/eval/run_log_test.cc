@@ -148,11 +148,13 @@ TEST_F(RunLogTest, ReadsTheAsynchronousSegmentationCounters) {
                R"("realtime": {"offered": 300, "dropped": 20, "processed_fps": 28.5,
                "latency_ms": {"median": 40, "mean": 42, "p99": 80, "max": 90},
                "asynchronous_segmentation": true, "frames_segmented": 95,
-               "mask_age_frames": {"median": 4, "mean": 4.2, "max": 11}, "keyframes_deferred": 7}, )");
+               "mask_age_frames": {"median": 4, "mean": 4.2, "max": 11}, "keyframes_deferred": 7,
+               "keyframes_stale_masks": 2}, )");
   const RunLog r = ReadRunLog(Write(text));
   EXPECT_TRUE(r.realtime.asynchronous);
   EXPECT_EQ(r.realtime.frames_segmented, 95);
   EXPECT_EQ(r.realtime.keyframes_deferred, 7);
+  EXPECT_EQ(r.realtime.keyframes_stale_masks, 2);
   EXPECT_DOUBLE_EQ(r.realtime.mask_age_median, 4.0);
   EXPECT_DOUBLE_EQ(r.realtime.mask_age_max, 11.0);
   text.replace(text.find("\"frames_segmented\": 95,"), 23, "");

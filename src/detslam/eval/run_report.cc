@@ -288,7 +288,9 @@ std::string RenderHtmlReport(const RunLog& run, const EvalResult* eval) {
                          " frames segmented; masks carried to each frame were " +
                          Fixed(t.mask_age_median, 0) + " frames old (median; max " +
                          Fixed(t.mask_age_max, 0) + "); " + std::to_string(t.keyframes_deferred) +
-                         " keyframes deferred for stale masks");
+                         " keyframes deferred for stale masks, " +
+                         std::to_string(t.keyframes_stale_masks) +
+                         " made with stale masks after waiting");
     }
   }
   const ErrorStats s = ComputeErrorStats(seg), e = ComputeErrorStats(ext),

@@ -129,9 +129,11 @@ TEST(RunReport, ACameraRateRunShowsItsDropsAndLatency) {
   log.realtime.mask_age_median = 4;
   log.realtime.mask_age_max = 9;
   log.realtime.keyframes_deferred = 3;
+  log.realtime.keyframes_stale_masks = 1;
   EXPECT_THAT(RenderHtmlReport(log, nullptr),
               HasSubstr("18 frames segmented; masks carried to each frame were 4 frames old "
-                        "(median; max 9); 3 keyframes deferred for stale masks"));
+                        "(median; max 9); 3 keyframes deferred for stale masks, 1 made with stale "
+                        "masks after waiting"));
 }
 
 TEST(RunReport, HtmlWithEvaluationEmbedsTheAccuracyFigure) {

@@ -49,44 +49,65 @@ LoopCloser::LoopCloser(const PinholeCamera& camera, LoopClosingOptions options)
 }
 
 LoopClosingResult LoopCloser::Process(Map& map, KeyFrameId kf_id) {
+  return Process([&map](const MapStep& step) { step(map); }, kf_id, nullptr);
+}
+
+LoopClosingResult LoopCloser::Process(const StepRunner& run_step, KeyFrameId kf_id,
+                                      const FinishFn& finish) {
   LoopClosingResult result;
   result.keyframe = kf_id;
-  if (!options_.enabled || !map.HasKeyFrame(kf_id)) return result;
-  if (last_loop_kf_ != kNoKeyFrame && kf_id - last_loop_kf_ < 5) return result;
-  const bool by_appearance = !map.keyframe(kf_id).features->bow.empty();
-  if (!by_appearance) {
-    for (const KeyFrameId candidate : CandidatesByPosition(map, kf_id)) {
-      Verified loop;
-      if (!Verify(map, kf_id, candidate, &loop)) continue;
-      Close(map, kf_id, loop, &result);
-      break;
+  bool searched = false;       // no candidate search this time (disabled, too soon, pending)
+  bool by_appearance = false;  // else by position: the first verified candidate closes
+  std::vector<KeyFrameId> candidates;
+  std::optional<Verified> to_close;
+  run_step([&](Map& map) {
+    if (!options_.enabled || !map.HasKeyFrame(kf_id)) return;
+    if (last_loop_kf_ != kNoKeyFrame && kf_id - last_loop_kf_ < 5) return;
+    by_appearance = !map.keyframe(kf_id).features->bow.empty();
+    if (!by_appearance) {
+      candidates = CandidatesByPosition(map, kf_id);
+      searched = true;
+      return;
     }
-    return result;
-  }
-  if (pending_ && ConfirmPending(map, kf_id)) {
-    if (pending_->coincidences >= options_.consistent_detections) {
-      const Verified loop = *pending_;
-      Close(map, kf_id, loop, &result);
+    if (pending_ && ConfirmPending(map, kf_id)) {
+      // Confirmed here: no new search (ORB-SLAM3 neither).
+      if (pending_->coincidences >= options_.consistent_detections) to_close = *pending_;
+      return;
     }
-    return result;  // confirmed here: no new search (ORB-SLAM3 neither)
+    candidates = CandidatesByAppearance(map, kf_id);
+    searched = true;
+  });
+  if (searched) {
+    // By appearance, the candidate most keyframes agree with replaces a pending loop that fewer
+    // agree with.
+    std::optional<Verified> best;
+    for (const KeyFrameId candidate : candidates) {
+      run_step([&](Map& map) {
+        if (!map.HasKeyFrame(kf_id) || !map.HasKeyFrame(candidate)) return;
+        Verified loop;
+        if (!Verify(map, kf_id, candidate, &loop)) return;
+        if (!by_appearance) {
+          best = std::move(loop);
+          return;
+        }
+        loop.coincidences = CountCoincidences(map, loop);
+        spdlog::debug("  loop candidate {} for keyframe {}: {} keyframes agree", candidate,
+                      kf_id, loop.coincidences);
+        if (!best || loop.coincidences > best->coincidences) best = std::move(loop);
+      });
+      if (!by_appearance && best) break;
+    }
+    if (best && (!by_appearance || best->coincidences >= options_.consistent_detections)) {
+      to_close = std::move(best);
+    } else if (best && (!pending_ || best->coincidences > pending_->coincidences)) {
+      pending_ = std::move(best);
+    }
   }
-  // New candidates by appearance; the one most keyframes agree with replaces a pending loop that
-  // fewer agree with.
-  std::optional<Verified> best;
-  for (const KeyFrameId candidate : CandidatesByAppearance(map, kf_id)) {
-    Verified loop;
-    if (!Verify(map, kf_id, candidate, &loop)) continue;
-    loop.coincidences = CountCoincidences(map, loop);
-    spdlog::debug("  loop candidate {} for keyframe {}: {} keyframes agree", candidate, kf_id,
-                  loop.coincidences);
-    if (!best || loop.coincidences > best->coincidences) best = std::move(loop);
-  }
-  if (best && best->coincidences >= options_.consistent_detections) {
-    const Verified loop = std::move(*best);
-    Close(map, kf_id, loop, &result);
-  } else if (best && (!pending_ || best->coincidences > pending_->coincidences)) {
-    pending_ = std::move(best);
-  }
+  run_step([&](Map& map) {
+    if (to_close && map.HasKeyFrame(kf_id) && map.HasKeyFrame(to_close->candidate))
+      Close(map, kf_id, *to_close, &result);
+    if (finish) finish(map, result);
+  });
   return result;
 }
 

@@ -23,6 +23,7 @@
 // `candidate_radius_m`, nearest first (needs a radius > 0), accepted on verification alone.
 #pragma once
 
+#include <functional>
 #include <map>
 #include <optional>
 #include <string>
@@ -96,9 +97,23 @@ class LoopCloser {
  public:
   LoopCloser(const PinholeCamera& camera, LoopClosingOptions options);
 
-  // Looks for and closes a loop at keyframe `kf` of `map` (the caller holds the map store's write
-  // access for the whole step). Deterministic.
+  // Runs one step with the map: `run_step(step)` calls step(map), e.g. under the map store's
+  // write access.
+  using MapStep = std::function<void(Map&)>;
+  using StepRunner = std::function<void(const MapStep&)>;
+  // Called in the last step of Process, under the same access as the correction (e.g. to move the
+  // tracker's state with the map), whether a loop was closed or not.
+  using FinishFn = std::function<void(Map&, const LoopClosingResult&)>;
+
+  // Looks for and closes a loop at keyframe `kf` of `map`. Deterministic.
   LoopClosingResult Process(Map& map, KeyFrameId kf);
+  // The same in steps, each run by `run_step` (so a lock can be released between them and
+  // tracking does not wait for the whole search): the candidate search, each candidate's
+  // verification, then the closing (fusion, pose graph) with `finish`. Between steps only
+  // tracking may change the map (new keyframes and points; the caller's thread is the one that
+  // erases keyframes); results carried across steps refer to landmarks by id and are checked
+  // again. With nothing else changing the map between steps, the result equals Process(map, kf).
+  LoopClosingResult Process(const StepRunner& run_step, KeyFrameId kf, const FinishFn& finish);
 
   int loops_closed() const { return loops_closed_; }  // merges not included
   int maps_merged() const { return maps_merged_; }

@@ -52,8 +52,12 @@ LocalMappingSummary LocalMapper::ProcessKeyFrame(KeyFrameId current, MapStore* s
     }
     map.UpdateConnections(current);
     CullLandmarks(map, current, &summary);
-    if (options_.triangulate) TriangulateNewLandmarks(map, current, &summary);
-    if (options_.fuse) FuseWithNeighbours(map, current, &summary);
+  }
+  if (options_.triangulate) TriangulateNewLandmarks(store, current, &summary);
+  {
+    const MapStore::WriteAccess access = store->Write();
+    Map& map = *access;
+    if (options_.fuse && map.HasKeyFrame(current)) FuseWithNeighbours(map, current, &summary);
     bundle_adjust = options_.local_ba && map.NumKeyFrames() > 2;
   }
   if (bundle_adjust) LocalBundleAdjustment(store, current, &summary);

@@ -53,13 +53,14 @@ class LocalMapper {
   LocalMapper(const PinholeCamera& camera, LocalMapperOptions options);
 
   // Processes a keyframe just inserted by the tracker. Deterministic. Every step holds the
-  // store's write access except the bundle-adjustment solve, which runs on a snapshot while the
-  // tracker may use the map (MapStore::ComputeOutsideLock).
+  // store's write access except the triangulation's descriptor matching (one neighbour at a time)
+  // and the bundle-adjustment solve (on a snapshot, MapStore::ComputeOutsideLock), which run
+  // while the tracker may use the map.
   LocalMappingSummary ProcessKeyFrame(KeyFrameId kf, MapStore* store);
 
  private:
   void CullLandmarks(Map& map, KeyFrameId current, LocalMappingSummary* summary);
-  void TriangulateNewLandmarks(Map& map, KeyFrameId current,
+  void TriangulateNewLandmarks(MapStore* store, KeyFrameId current,
                                LocalMappingSummary* summary);  // triangulate.cc
   void FuseWithNeighbours(Map& map, KeyFrameId current, LocalMappingSummary* summary);
   void LocalBundleAdjustment(MapStore* store, KeyFrameId current, LocalMappingSummary* summary);

@@ -60,28 +60,50 @@ bool WithinGate(const PinholeCamera& camera, const ScaleInfo& scale, const KeyFr
 
 }  // namespace
 
-void LocalMapper::TriangulateNewLandmarks(Map& map, KeyFrameId current,
+void LocalMapper::TriangulateNewLandmarks(MapStore* store, KeyFrameId current,
                                           LocalMappingSummary* summary) {
-  const ScaleInfo& scale = map.scale();
   const double close_depth = camera_.CloseDepthThreshold();
-  const double ratio_factor = 1.5 * (scale.scale_factors.size() > 1 ? scale.scale_factors[1] : 1.2);
   MatchOptions match;
   match.ratio = 0.6;
   match.max_distance = kThLow;
-  for (KeyFrameId other :
-       map.BestCovisibles(current, static_cast<size_t>(options_.triangulation_neighbours))) {
-    const KeyFrame& kf1 = map.keyframe(current);
-    const KeyFrame& kf2 = map.keyframe(other);
-    if ((kf1.Center() - kf2.Center()).norm() < camera_.Baseline()) continue;  // too close
-    const std::vector<int> c1 = Candidates(kf1, close_depth), c2 = Candidates(kf2, close_depth);
-    if (c1.empty() || c2.empty()) continue;
-    const FrameFeatures& f1 = *kf1.features;
-    const FrameFeatures& f2 = *kf2.features;
+  std::vector<KeyFrameId> neighbours;
+  {
+    const MapStore::ReadAccess map = store->Read();
+    if (!map->HasKeyFrame(current)) return;
+    neighbours =
+        map->BestCovisibles(current, static_cast<size_t>(options_.triangulation_neighbours));
+  }
+  // One neighbour at a time, in three steps: its candidates (under the lock), the descriptor
+  // matching (the costly part, without it: the features never change), the new landmarks
+  // (under the lock again, where every check is made on the map as it is then).
+  for (KeyFrameId other : neighbours) {
+    std::vector<int> c1, c2;
     std::vector<cv::KeyPoint> kp1, kp2;
     cv::Mat d1, d2;
-    Subset(f1, c1, &kp1, &d1);
-    Subset(f2, c2, &kp2, &d2);
-    for (const cv::DMatch& m : MatchBruteForce(kp1, d1, kp2, d2, match)) {
+    {
+      const MapStore::ReadAccess map = store->Read();
+      if (!map->HasKeyFrame(current) || !map->HasKeyFrame(other)) continue;
+      const KeyFrame& kf1 = map->keyframe(current);
+      const KeyFrame& kf2 = map->keyframe(other);
+      if ((kf1.Center() - kf2.Center()).norm() < camera_.Baseline()) continue;  // too close
+      c1 = Candidates(kf1, close_depth);
+      c2 = Candidates(kf2, close_depth);
+      if (c1.empty() || c2.empty()) continue;
+      Subset(*kf1.features, c1, &kp1, &d1);
+      Subset(*kf2.features, c2, &kp2, &d2);
+    }
+    const std::vector<cv::DMatch> matches = MatchBruteForce(kp1, d1, kp2, d2, match);
+    const MapStore::WriteAccess access = store->Write();
+    Map& map = *access;
+    if (!map.HasKeyFrame(current) || !map.HasKeyFrame(other)) continue;
+    const ScaleInfo& scale = map.scale();
+    const double ratio_factor =
+        1.5 * (scale.scale_factors.size() > 1 ? scale.scale_factors[1] : 1.2);
+    const KeyFrame& kf1 = map.keyframe(current);
+    const KeyFrame& kf2 = map.keyframe(other);
+    const FrameFeatures& f1 = *kf1.features;
+    const FrameFeatures& f2 = *kf2.features;
+    for (const cv::DMatch& m : matches) {
       const size_t i1 = static_cast<size_t>(c1[static_cast<size_t>(m.queryIdx)]);
       const size_t i2 = static_cast<size_t>(c2[static_cast<size_t>(m.trainIdx)]);
       if (map.keyframe(current).landmarks[i1] != kNoLandmark) continue;  // taken by an earlier pair

@@ -170,7 +170,9 @@ void WriteRunOutputs(const RgbdSource& dataset, const Settings& settings, const 
                      {"inliers", r.inliers},
                      {"agreeing_keyframes", r.agreeing},
                      {"correction_m", r.correction_m},
-                     {"merge", r.merge}});
+                     {"merge", r.merge},
+                     {"corrected_after_frame", r.corrected_after_frame},
+                     {"map_locked_ms", r.map_locked_ms}});
   }
   j["loops"] = loops;
   const LoopDetectionStats& ld = summary.loop_detection;
@@ -181,7 +183,9 @@ void WriteRunOutputs(const RgbdSource& dataset, const Settings& settings, const 
                          {"pending_confirmed", ld.pending_confirmed},
                          {"pending_dropped", ld.pending_dropped},
                          {"revisits", ld.revisits}};
-  j["global_ba"] = {{"runs", summary.global_ba_runs}, {"stopped", summary.global_ba_stopped}};
+  j["global_ba"] = {{"runs", summary.global_ba_runs},
+                    {"stopped", summary.global_ba_stopped},
+                    {"applied_after_frames", summary.global_ba_applied_after_frames}};
   if (!options.save_map.empty())
     j["map_file"] = {{"path", options.save_map}, {"bytes", summary.map_file_bytes}};
   if (!options.load_map.empty()) {
@@ -233,6 +237,7 @@ void WriteRunOutputs(const RgbdSource& dataset, const Settings& settings, const 
                                           {"mean", summary.mask_age.mean},
                                           {"max", summary.mask_age.max}};
       j["realtime"]["keyframes_deferred"] = summary.keyframes_deferred;
+      j["realtime"]["keyframes_stale_masks"] = summary.keyframes_stale_masks;
     }
   }
   j["segmenter"] = summary.segmenter.empty() ? "none" : summary.segmenter;
@@ -245,7 +250,9 @@ void WriteRunOutputs(const RgbdSource& dataset, const Settings& settings, const 
                          {"memory_frames", dyn.memory_frames},
                          {"geometric_check", dyn.geometric.enabled},
                          {"segment_every", dyn.segment_every},
-                         {"keyframe_max_mask_age", dyn.keyframe_max_mask_age}};
+                         {"keyframe_max_mask_age", dyn.keyframe_max_mask_age},
+                         {"keyframe_max_wait", dyn.keyframe_max_wait},
+                         {"keyframe_defer_min_inliers", dyn.keyframe_defer_min_inliers}};
   j["timings"] = {{"segmentation", StatsJson(summary.segmentation)},
                   {"extraction", StatsJson(summary.extraction)},
                   {"tracking", StatsJson(summary.tracking)},
@@ -281,6 +288,7 @@ void WriteRunOutputs(const RgbdSource& dataset, const Settings& settings, const 
       per_frame.back()["mask_age"] = r.mask_age;
     }
     if (r.keyframe_deferred) per_frame.back()["keyframe_deferred"] = true;
+    if (r.keyframe_stale_masks) per_frame.back()["keyframe_stale_masks"] = true;
   }
   j["per_frame"] = per_frame;
   WriteFileAtomically((out / "run.json").string(),

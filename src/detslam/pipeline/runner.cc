@@ -134,6 +134,7 @@ class RunRecorder {
     if (r.latency_ms >= 0) latency_.push_back(r.latency_ms);
     if (r.mask_age >= 0) mask_age_.push_back(r.mask_age);
     if (r.keyframe_deferred) ++summary_.keyframes_deferred;
+    if (r.keyframe_stale_masks) ++summary_.keyframes_stale_masks;
     summary_.reports.push_back(r);
     if (progress_) progress_(summary_.frames, total_, r);
   }
@@ -206,6 +207,7 @@ class RunRecorder {
     summary_.loop_detection = slam.loop_detection_stats();
     summary_.global_ba_runs = slam.global_ba_runs();
     summary_.global_ba_stopped = slam.global_ba_stopped();
+    summary_.global_ba_applied_after_frames = slam.global_ba_applied_after_frames();
     {
       const MapStore::ReadAccess map = slam.ReadMap();
       summary_.keyframes = map->NumKeyFrames();

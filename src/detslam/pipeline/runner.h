@@ -88,6 +88,7 @@ struct RunSummary {
   LoopDetectionStats loop_detection;
   int global_ba_runs = 0;     // global bundle adjustments started after loops
   int global_ba_stopped = 0;  // ... stopped early by a newer loop (solution discarded)
+  std::vector<int64_t> global_ba_applied_after_frames;  // SlamSystem's
   uint64_t map_file_bytes = 0;  // size of the map file written (save_map)
   uint64_t loaded_keyframes = 0, loaded_landmarks = 0;  // of the map loaded (load_map)
   double map_load_ms = 0;                               // reading and restoring it
@@ -108,6 +109,7 @@ struct RunSummary {
   size_t frames_segmented = 0;
   ErrorStats mask_age;
   size_t keyframes_deferred = 0;
+  size_t keyframes_stale_masks = 0;  // made with stale masks after waiting (FrameReport)
   size_t keyframe_masks = 0;  // written to out_dir/keyframe_masks
   DenseMapStats dense;        // of the dense map (dense_map)
   double wall_s = 0;

@@ -122,6 +122,8 @@ std::vector<Binding> MakeBindings() {
   // Segmentation.
   k.push_back(Key("Segmentation.EveryK", 1, kInf, "segment every K-th frame; masks follow the optical flow in between (--segment-every)", [](auto& r) -> auto& { return r.run.slam.dynamic.segment_every; }));
   k.push_back(Key("Segmentation.KeyFrameMaxMaskAge", 0, kInf, "camera-rate mode (asynchronous segmentation): a frame whose masks were segmented more than this many input frames earlier makes no keyframe", [](auto& r) -> auto& { return r.run.slam.dynamic.keyframe_max_mask_age; }));
+  k.push_back(Key("Segmentation.KeyFrameMaxWait", 0, kInf, "camera-rate mode (asynchronous segmentation): a keyframe waits for masks at most Segmentation.KeyFrameMaxMaskAge frames old for at most this many input frames after the first frame that asked for it, then it is made with the masks it has", [](auto& r) -> auto& { return r.run.slam.dynamic.keyframe_max_wait; }));
+  k.push_back(Key("Segmentation.KeyFrameDeferMinInliers", 0, kInf, "camera-rate mode (asynchronous segmentation): a keyframe waits for fresh masks only while the frame tracks at least this many map points; below, it is made at once with the masks it has", [](auto& r) -> auto& { return r.run.slam.dynamic.keyframe_defer_min_inliers; }));
   k.push_back(Key("Segmentation.Detector", "dnn: first detector, .onnx (YOLOX) or Darknet .cfg (relative: models folder)", [](auto& r) -> auto& { return r.segmenter.detector; }));
   k.push_back(Key("Segmentation.Weights", "dnn: Darknet weights (empty: beside the detector)", [](auto& r) -> auto& { return r.segmenter.weights; }));
   k.push_back(Key("Segmentation.Names", "dnn: class names file (empty: coco.names beside the detector)", [](auto& r) -> auto& { return r.segmenter.names; }));

@@ -94,24 +94,40 @@ void SlamSystem::MapKeyFrame(KeyFrameId kf, FrameReport* report) {
       erased_[e.id] = e;
       tracker_.OnKeyFrameErased(*map, e.id);
     }
-    const LoopClosingResult loop = loop_closer_.Process(*map, kf);
+  }
+  // Loop closing in steps, each under its own write access, so that tracking goes on between
+  // the candidate search and each candidate's verification; the correction and everything that
+  // must move with it (the tracker, the bookkeeping) share the last step.
+  double longest_step_ms = 0;  // the longest time tracking could have waited for loop closing
+  const auto run_step = [&](const LoopCloser::MapStep& step) {
+    const MapStore::WriteAccess map = store_.Write();
+    const auto step_t0 = std::chrono::steady_clock::now();
+    step(*map);
+    longest_step_ms = std::max(longest_step_ms, MsSince(step_t0));
+  };
+  const auto finish = [&](Map& map, const LoopClosingResult& loop) {
     if (loop_closer_.has_pending()) tracker_.RequestKeyFrame();
-    if (loop.closed) {
-      tracker_.OnLoopClosed(*map, loop.old_poses);
-      report->loop_closed = true;
-      report->loop_keyframe = loop.keyframe;
-      report->loop_candidate = loop.candidate;
-      report->loop_candidate_frame = map->keyframe(loop.candidate).frame_index;
-      report->loop_inliers = loop.inliers;
-      report->loop_agreeing = loop.agreeing;
-      report->loop_correction_m = loop.correction_m;
-      report->maps_merged = loop.merged;
-      loops_.push_back({map->keyframe(loop.keyframe).frame_index, loop.keyframe, loop.candidate,
-                        report->loop_candidate_frame, loop.inliers, loop.agreeing,
-                        loop.correction_m, loop.merged, loop.merged_from, loop.merged_into});
-      ++loop_generation_;
-      global_ba = options_.loop.global_ba_iterations > 0 && !interrupted_;
-    }
+    if (!loop.closed) return;
+    tracker_.OnLoopClosed(map, loop.old_poses);
+    report->loop_closed = true;
+    report->loop_keyframe = loop.keyframe;
+    report->loop_candidate = loop.candidate;
+    report->loop_candidate_frame = map.keyframe(loop.candidate).frame_index;
+    report->loop_inliers = loop.inliers;
+    report->loop_agreeing = loop.agreeing;
+    report->loop_correction_m = loop.correction_m;
+    report->maps_merged = loop.merged;
+    loops_.push_back({map.keyframe(loop.keyframe).frame_index, loop.keyframe, loop.candidate,
+                      report->loop_candidate_frame, loop.inliers, loop.agreeing,
+                      loop.correction_m, loop.merged, loop.merged_from, loop.merged_into,
+                      last_tracked_frame_, 0.0});
+    ++loop_generation_;
+    global_ba = options_.loop.global_ba_iterations > 0 && !interrupted_;
+  };
+  loop_closer_.Process(run_step, kf, finish);
+  if (report->loop_closed) {
+    const MapStore::WriteAccess map = store_.Write();
+    loops_.back().map_locked_ms = longest_step_ms;
   }
   if (global_ba) {
     // Without the lock: tracking (and, in its own thread, local mapping) goes on while the whole
@@ -124,6 +140,7 @@ void SlamSystem::MapKeyFrame(KeyFrameId kf, FrameReport* report) {
           camera_, options_.loop.global_ba_iterations, &store_,
           [this](Map& map, const std::map<KeyFrameId, Rigid3d>& old_poses) {
             tracker_.OnLoopClosed(map, old_poses);
+            global_ba_applied_.push_back(last_tracked_frame_);
           },
           [this, generation](const Map&) { return loop_generation_ == generation; },
           &stop_global_ba_);
@@ -185,6 +202,11 @@ uint64_t SlamSystem::SaveMap(const std::string& path) const {
 int SlamSystem::global_ba_runs() const { return global_ba_runs_; }
 
 int SlamSystem::global_ba_stopped() const { return global_ba_stopped_; }
+
+std::vector<int64_t> SlamSystem::global_ba_applied_after_frames() const {
+  const MapStore::ReadAccess map = store_.Read();
+  return global_ba_applied_;
+}
 
 int SlamSystem::loops_closed() const {
   const MapStore::ReadAccess map = store_.Read();
@@ -267,18 +289,28 @@ KeyFrameId SlamSystem::TrackFrame(Frame frame, FrameReport* report, Frame* track
   const MapStore::WriteAccess access = store_.Write();
   Map& map = *access;
   const size_t kfs_before = map.NumKeyFrames();
+  last_tracked_frame_ = report->index;
   report->tracking = tracker_.Track(map, &frame);
   KeyFrameId new_kf = kNoKeyFrame;
   if (report->tracking.pose_valid && report->tracking.need_keyframe && !options_.localization) {
-    // Asynchronous segmentation: no new map points from masks carried over too many frames.
-    if (report->mask_age > options_.dynamic.keyframe_max_mask_age) {
+    // Asynchronous segmentation: no new map points from masks carried over too many frames,
+    // unless tracking is getting weak or the keyframe has waited keyframe_max_wait frames.
+    const DetSlamOptions& dyn = options_.dynamic;
+    const bool stale = report->mask_age > dyn.keyframe_max_mask_age;
+    if (stale && keyframe_wait_since_ < 0) keyframe_wait_since_ = report->index;
+    if (stale && report->tracking.num_inliers >= dyn.keyframe_defer_min_inliers &&
+        report->index - keyframe_wait_since_ < dyn.keyframe_max_wait) {
       report->keyframe_deferred = true;
     } else {
       new_kf = tracker_.CreateKeyFrame(map, &frame);
+      report->keyframe_stale_masks = stale;
+      keyframe_wait_since_ = -1;
     }
   }
-  if (map.NumKeyFrames() > kfs_before && new_kf == kNoKeyFrame)
-    new_kf = tracker_.reference_keyframe();
+  if (map.NumKeyFrames() > kfs_before && new_kf == kNoKeyFrame) {
+    new_kf = tracker_.reference_keyframe();  // a new map's first keyframe
+    keyframe_wait_since_ = -1;
+  }
   report->timings.tracking_ms = MsSince(t0);
 
   if (report->tracking.pose_valid) {

@@ -57,6 +57,12 @@ struct LoopRecord {
   double correction_m = 0;             // how far the pose graph moved the keyframe
   bool merge = false;                  // the candidate was in another map: two maps merged
   int merged_from = -1, merged_into = -1;
+  // When the correction was applied: the newest input frame tracked by then (a mapping thread
+  // corrects some frames after the keyframe's), and the longest time loop closing held the map's
+  // lock in one step for this keyframe (candidate search, one candidate's verification, or the
+  // correction with fusion and pose graph): the longest tracking could have waited for it.
+  int64_t corrected_after_frame = -1;
+  double map_locked_ms = 0;
 };
 
 // Every tracked frame's pose, by the map of the atlas that holds it at the end of the run (maps
@@ -84,6 +90,9 @@ struct FrameReport {
   // The tracker asked for a keyframe but the frame's masks were older than
   // DetSlamOptions::keyframe_max_mask_age: no keyframe was made from it.
   bool keyframe_deferred = false;
+  // A keyframe was made from masks older than that limit: tracking had become too weak to wait
+  // (DetSlamOptions::keyframe_defer_min_inliers) or it had waited keyframe_max_wait frames.
+  bool keyframe_stale_masks = false;
   Timestamp stamp;
   TrackingResult tracking;
   bool keyframe = false;
@@ -182,6 +191,9 @@ class SlamSystem {
   // while they ran (their solution is discarded: it predates that loop's correction).
   int global_ba_runs() const;
   int global_ba_stopped() const;
+  // For each global BA whose solution was applied to the map: the newest input frame tracked by
+  // then.
+  std::vector<int64_t> global_ba_applied_after_frames() const;
   LoopDetectionStats loop_detection_stats() const;
   // Starts from the map in a map file (before the first frame): the tracker relocalises in it
   // from the first frame on; new keyframes extend it unless in localisation mode. Throws
@@ -219,6 +231,9 @@ class SlamSystem {
   std::map<KeyFrameId, ErasedKeyFrame> erased_;
   std::vector<double> mapping_times_ms_;
   std::vector<LoopRecord> loops_;
+  int64_t last_tracked_frame_ = -1;  // the newest frame TrackFrame has seen
+  int64_t keyframe_wait_since_ = -1;  // the first frame whose keyframe was deferred (-1: none)
+  std::vector<int64_t> global_ba_applied_;  // global_ba_applied_after_frames()
   std::thread global_ba_;  // with global_ba_thread: the running (or last) global BA
   int loop_generation_ = 0;  // loops corrected so far (a global BA started before one is stale)
   std::atomic<bool> stop_global_ba_{false};     // asks the running global BA to stop
