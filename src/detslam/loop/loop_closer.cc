@@ -77,10 +77,8 @@ LoopClosingResult LoopCloser::Process(const StepRunner& run_step, KeyFrameId kf_
     candidates = CandidatesByAppearance(map, kf_id);
     searched = true;
   });
+  std::optional<Verified> best;  // the verified candidate (by appearance: most agreed on)
   if (searched) {
-    // By appearance, the candidate most keyframes agree with replaces a pending loop that fewer
-    // agree with.
-    std::optional<Verified> best;
     for (const KeyFrameId candidate : candidates) {
       run_step([&](Map& map) {
         if (!map.HasKeyFrame(kf_id) || !map.HasKeyFrame(candidate)) return;
@@ -97,13 +95,16 @@ LoopClosingResult LoopCloser::Process(const StepRunner& run_step, KeyFrameId kf_
       });
       if (!by_appearance && best) break;
     }
+  }
+  // Every change of this object's state is made inside a step (under the caller's lock).
+  run_step([&](Map& map) {
+    // By appearance, the candidate most keyframes agree with replaces a pending loop that fewer
+    // agree with.
     if (best && (!by_appearance || best->coincidences >= options_.consistent_detections)) {
       to_close = std::move(best);
     } else if (best && (!pending_ || best->coincidences > pending_->coincidences)) {
       pending_ = std::move(best);
     }
-  }
-  run_step([&](Map& map) {
     if (to_close && map.HasKeyFrame(kf_id) && map.HasKeyFrame(to_close->candidate))
       Close(map, kf_id, *to_close, &result);
     if (finish) finish(map, result);
