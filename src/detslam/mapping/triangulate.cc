@@ -67,9 +67,12 @@ void LocalMapper::TriangulateNewLandmarks(MapStore* store, KeyFrameId current,
   match.ratio = 0.6;
   match.max_distance = kThLow;
   std::vector<KeyFrameId> neighbours;
+  double ratio_factor = 0;  // scale consistency: the map's pyramid never changes
   {
     const MapStore::ReadAccess map = store->Read();
     if (!map->HasKeyFrame(current)) return;
+    const std::vector<double>& factors = map->scale().scale_factors;
+    ratio_factor = 1.5 * (factors.size() > 1 ? factors[1] : 1.2);
     neighbours =
         map->BestCovisibles(current, static_cast<size_t>(options_.triangulation_neighbours));
   }
@@ -97,8 +100,6 @@ void LocalMapper::TriangulateNewLandmarks(MapStore* store, KeyFrameId current,
     Map& map = *access;
     if (!map.HasKeyFrame(current) || !map.HasKeyFrame(other)) continue;
     const ScaleInfo& scale = map.scale();
-    const double ratio_factor =
-        1.5 * (scale.scale_factors.size() > 1 ? scale.scale_factors[1] : 1.2);
     const KeyFrame& kf1 = map.keyframe(current);
     const KeyFrame& kf2 = map.keyframe(other);
     const FrameFeatures& f1 = *kf1.features;
