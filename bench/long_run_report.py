@@ -25,6 +25,7 @@ import os
 import statistics
 import sys
 
+from frame_panels import FramePanels
 from update_section import write_atomically
 
 prefix, run_dir, ate, monitor_rc, frames = sys.argv[1:6]
@@ -151,24 +152,7 @@ print()
 W, L, R, T, GAP, PH = 760, 70, 70, 34, 40, 120
 H = T + 3 * PH + 2 * GAP + 50
 x_max = max(offered, 1)
-
-
-def xpix(f):
-    return L + (W - L - R) * f / x_max
-
-
-def poly(points, y_max, top, colour, width=1.5):
-    pts = " ".join(f"{xpix(f):.1f},{top + PH - PH * min(v, y_max) / max(y_max, 1e-9):.1f}"
-                   for f, v in points)
-    return f'<polyline fill="none" stroke="{colour}" stroke-width="{width}" points="{pts}"/>'
-
-
-def axes(top, y_max, label, colour):
-    return [f'<rect x="{L}" y="{top}" width="{W - L - R}" height="{PH}" fill="none" stroke="#999"/>',
-            f'<text x="{L - 8}" y="{top + 4}" text-anchor="end" font-size="11">{y_max:.0f}</text>',
-            f'<text x="{L - 8}" y="{top + PH}" text-anchor="end" font-size="11">0</text>',
-            f'<text x="{L - 8}" y="{top + PH / 2}" text-anchor="end" font-size="11" '
-            f'fill="{colour}">{html.escape(label)}</text>']
+panels = FramePanels(W, L, R, PH, x_max)
 
 
 svg = [f'<svg xmlns="http://www.w3.org/2000/svg" width="{W}" height="{H}" font-family="sans-serif">',
@@ -185,9 +169,9 @@ centres = sorted(bins)
 med_pts = [((b + 0.5) * bin_frames, statistics.median(bins[b])) for b in centres]
 max_pts = [((b + 0.5) * bin_frames, max(bins[b])) for b in centres]
 y1 = 1.5 * STALL_MS  # maxima above are clipped at the top
-svg += axes(tops[0], y1, "tracking ms", "#2166ac")
-svg.append(poly(max_pts, y1, tops[0], "#9ecae1", 1.0))
-svg.append(poly(med_pts, y1, tops[0], "#2166ac"))
+svg += panels.axes(tops[0], y1, "tracking ms", "#2166ac")
+svg.append(panels.line(max_pts, y1, tops[0], "#9ecae1", 1.0))
+svg.append(panels.line(med_pts, y1, tops[0], "#2166ac"))
 ys = tops[0] + PH - PH * STALL_MS / y1
 svg.append(f'<line x1="{L}" x2="{W - R}" y1="{ys:.1f}" y2="{ys:.1f}" stroke="#c0392b" stroke-dasharray="4,3"/>')
 svg.append(f'<text x="{W - R + 4}" y="{ys + 4:.1f}" font-size="10" fill="#c0392b">2 frames</text>')
@@ -195,16 +179,16 @@ svg.append(f'<text x="{W - R + 4}" y="{tops[0] + 12}" font-size="10" fill="#2166
 svg.append(f'<text x="{W - R + 4}" y="{tops[0] + 24}" font-size="10" fill="#6baed6">max</text>')
 plotted = list({r[1]: r for r in samples}.values())
 y2 = max(r[4] for r in samples) * 1.1
-svg += axes(tops[1], y2, "RSS MiB", "#c0392b")
-svg.append(poly([(r[1], r[4]) for r in plotted], y2, tops[1], "#c0392b"))
+svg += panels.axes(tops[1], y2, "RSS MiB", "#c0392b")
+svg.append(panels.line([(r[1], r[4]) for r in plotted], y2, tops[1], "#c0392b"))
 y3 = max(max(r[2] for r in samples), 1) * 1.2
-svg += axes(tops[2], y3, "keyframes", "#1a9850")
-svg.append(poly([(r[1], r[2]) for r in plotted], y3, tops[2], "#1a9850"))
+svg += panels.axes(tops[2], y3, "keyframes", "#1a9850")
+svg.append(panels.line([(r[1], r[2]) for r in plotted], y3, tops[2], "#1a9850"))
 for name, f, _ in events:
-    svg.append(f'<line x1="{xpix(f):.1f}" x2="{xpix(f):.1f}" y1="{tops[0]}" y2="{tops[2] + PH}" '
+    svg.append(f'<line x1="{panels.x(f):.1f}" x2="{panels.x(f):.1f}" y1="{tops[0]}" y2="{tops[2] + PH}" '
                f'stroke="#7b3294" stroke-dasharray="2,3"><title>{html.escape(name)}</title></line>')
 for k in range(6):
-    svg.append(f'<text x="{xpix(x_max * k / 5):.1f}" y="{tops[2] + PH + 16}" text-anchor="middle" '
+    svg.append(f'<text x="{panels.x(x_max * k / 5):.1f}" y="{tops[2] + PH + 16}" text-anchor="middle" '
                f'font-size="11">{x_max * k / 5:.0f}</text>')
 svg.append(f'<text x="{W / 2}" y="{tops[2] + PH + 34}" text-anchor="middle" font-size="12">input frame '
            f'(dotted: loop corrections and global BA solutions applied)</text>')

@@ -9,11 +9,11 @@ Memory counts as bounded when the resident memory at the last frame is at most 1
 the run (the outputs written after the last frame make a one-off peak, reported apart): over the second half of a sequence that keeps going round the same room the map should not
 grow, since keyframes that add nothing are culled.
 """
-import html
 import json
 import os
 import sys
 
+from frame_panels import FramePanels
 from update_section import write_atomically
 
 prefix, run_dir, ate, monitor_rc, frames = sys.argv[1:6]
@@ -57,21 +57,7 @@ else:
 # The figure: two panels sharing the frame axis.
 W, H, L, R, T, GAP, PH = 760, 440, 70, 70, 30, 50, 150
 x_max = max(frames, 1)
-
-
-def poly(points, y_max, top, colour):
-    pts = " ".join(f"{L + (W - L - R) * f / x_max:.1f},{top + PH - PH * v / max(y_max, 1e-9):.1f}"
-                   for f, v in points)
-    return f'<polyline fill="none" stroke="{colour}" stroke-width="1.5" points="{pts}"/>'
-
-
-def axes(top, y_max, label, colour):
-    out = [f'<rect x="{L}" y="{top}" width="{W - L - R}" height="{PH}" fill="none" stroke="#999"/>',
-           f'<text x="{L - 8}" y="{top + 4}" text-anchor="end" font-size="11">{y_max:.0f}</text>',
-           f'<text x="{L - 8}" y="{top + PH}" text-anchor="end" font-size="11">0</text>',
-           f'<text x="{L - 8}" y="{top + PH / 2}" text-anchor="end" font-size="11" '
-           f'fill="{colour}">{html.escape(label)}</text>']
-    return out
+panels = FramePanels(W, L, R, PH, x_max)
 
 
 svg = [f'<svg xmlns="http://www.w3.org/2000/svg" width="{W}" height="{H}" '
@@ -85,17 +71,17 @@ if rows:
     kf_max = max(r[2] for r in rows) * 1.1
     pt_max = max(r[3] for r in rows) * 1.1
     top1, top2 = T + 10, T + 10 + PH + GAP
-    svg += axes(top1, rss_max, "RSS MiB", "#c0392b")
-    svg.append(poly([(r[1], r[4]) for r in plotted], rss_max, top1, "#c0392b"))
-    svg += axes(top2, kf_max, "keyframes", "#2166ac")
-    svg.append(poly([(r[1], r[2]) for r in plotted], kf_max, top2, "#2166ac"))
-    svg.append(poly([(r[1], r[3] * kf_max / pt_max) for r in plotted], kf_max, top2, "#1a9850"))
+    svg += panels.axes(top1, rss_max, "RSS MiB", "#c0392b")
+    svg.append(panels.line([(r[1], r[4]) for r in plotted], rss_max, top1, "#c0392b"))
+    svg += panels.axes(top2, kf_max, "keyframes", "#2166ac")
+    svg.append(panels.line([(r[1], r[2]) for r in plotted], kf_max, top2, "#2166ac"))
+    svg.append(panels.line([(r[1], r[3] * kf_max / pt_max) for r in plotted], kf_max, top2, "#1a9850"))
     svg.append(f'<text x="{W - R + 6}" y="{top2 + 12}" font-size="11" fill="#1a9850">points</text>')
     svg.append(f'<text x="{W - R + 6}" y="{top2 + 26}" font-size="11" fill="#1a9850">'
                f'(max {pt_max / 1.1:.0f})</text>')
     for k in range(0, 6):
         f = x_max * k / 5
-        x = L + (W - L - R) * k / 5
+        x = panels.x(f)
         svg.append(f'<text x="{x:.1f}" y="{top2 + PH + 16}" text-anchor="middle" '
                    f'font-size="11">{f:.0f}</text>')
     svg.append(f'<text x="{W / 2}" y="{top2 + PH + 34}" text-anchor="middle" font-size="12">'
