@@ -44,8 +44,11 @@ void CheckOrder(const std::string& list, int line, Timestamp stamp, Timestamp pr
 }
 
 void CheckImageExists(const std::string& list, int line, const std::string& image) {
-  if (!fs::is_regular_file(image)) {
-    throw InputError(list, line, "listed image file does not exist: " + image);
+  std::error_code ec;  // e.g. a name too long for the file system: an input error, not a crash
+  if (!fs::is_regular_file(image, ec)) {
+    throw InputError(list, line,
+                     "listed image file does not exist: " + image +
+                         (ec ? " (" + ec.message() + ")" : std::string()));
   }
 }
 

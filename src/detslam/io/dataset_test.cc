@@ -196,6 +196,13 @@ TEST_F(RgbdDatasetTest, MissingFolderAndListsAreErrors) {
   }
 }
 
+TEST_F(RgbdDatasetTest, AnImageNameTooLongForTheFileSystemIsAnInputError) {
+  // Found by the dataset fuzzer: the throwing std::filesystem call ended the program.
+  WriteText("rgb.txt", "0 rgb/" + std::string(300, 's') + ".png\n");
+  WriteText("depth.txt", "0 depth/0.png\n");
+  EXPECT_THAT(OpenError(), HasSubstr("rgb.txt:1"));
+}
+
 TEST_F(RgbdDatasetTest, MalformedLinesNameFileAndLine) {
   WriteSequence({"1.0"}, {"1.0"});
   WriteText("rgb.txt", "# header\n1.0 rgb/1.0.png\n2.0\n");
