@@ -18,6 +18,7 @@ void AddSynthCommand(CLI::App& app) {
   auto no_people = std::make_shared<bool>(false);
   auto cut = std::make_shared<std::string>();
   auto cover = std::make_shared<std::string>();
+  auto realism = std::make_shared<std::string>("easy");
   std::string presets;
   for (const auto& p : SynthPresetNames()) presets += (presets.empty() ? "" : ", ") + p;
   cmd->add_option("--preset", opts->preset, "Camera/people script: " + presets)
@@ -31,7 +32,16 @@ void AddSynthCommand(CLI::App& app) {
   cmd->add_option("--people", opts->people_dir,
                   "Folder of RGBA person cut-outs (*.png, alpha = silhouette) to texture people");
   cmd->add_flag("--no-people", *no_people, "Static twin: same camera path, no moving people");
-  cmd->add_flag("--blur", opts->motion_blur, "Motion blur from the camera velocity");
+  cmd->add_flag("--blur", opts->motion_blur,
+                "Motion blur from the camera velocity (easy mode; the realistic sensor always "
+                "blurs by camera and people motion)");
+  cmd->add_option("--realism", *realism,
+                  "Sensor model: 'easy' (i.i.d. axial depth noise, 3-5 % missing depth, sharp "
+                  "colour) or 'realistic' (Kinect-v1-like depth at its own timestamp: 1/8 px "
+                  "disparity steps, correlated noise, distortion, projector shadows, mixed edge "
+                  "pixels, no return from dark or grazing surfaces, registration borders; rolling "
+                  "shutter, motion blur, lens softness, photon noise, exposure drift)")
+      ->capture_default_str();
   cmd->add_option("--depth-scale-bias", opts->depth_scale_bias,
                   "Depth miscalibration F: written depth x 1 + F sin^2(pi k / (frames - 1)) (rises "
                   "to 1 + F mid-sequence, back to 1 at the end; ground truth stays true); 0 = off")
@@ -46,8 +56,9 @@ void AddSynthCommand(CLI::App& app) {
   cmd->add_option("--out", *out_dir, "Output folder")->required();
   cmd->add_option("--stats-json", *stats_json,
                   "Write timing and content statistics (fps, FAST corners, coverage) as JSON");
-  cmd->callback([opts, out_dir, stats_json, no_people, cut, cover] {
+  cmd->callback([opts, out_dir, stats_json, no_people, cut, cover, realism] {
     opts->people = !*no_people;
+    opts->realism = ParseSynthRealism(*realism);
     if (!cut->empty()) ParseSynthCut(*cut, opts.get());
     if (!cover->empty()) ParseSynthCover(*cover, opts.get());
     RequireSynthPreset(opts->preset);
@@ -64,6 +75,7 @@ void AddSynthCommand(CLI::App& app) {
                           {"people", opts->people},
                           {"people_dir", opts->people_dir},
                           {"motion_blur", opts->motion_blur},
+                          {"realism", SynthRealismName(opts->realism)},
                           {"depth_scale_bias", opts->depth_scale_bias},
                           {"cut", cut_frames},
                           {"cover", opts->HasCover() ? nlohmann::json::array(
@@ -77,6 +89,7 @@ void AddSynthCommand(CLI::App& app) {
                           {"total_fps", s.total_fps},
                           {"mean_fast20_corners", s.mean_fast_corners},
                           {"fast_sampled_frames", s.sampled_frames},
+                          {"mean_missing_depth", s.mean_missing_depth},
                           {"mean_people_coverage", s.mean_coverage}};
       WriteFileAtomically(*stats_json, [&](std::ostream& os) { os << j.dump(2) << "\n"; });
     }

@@ -86,6 +86,16 @@ bool SynthOptions::Check(std::string* error) const {
   return os.str().empty();
 }
 
+const char* SynthRealismName(SynthRealism realism) {
+  return realism == SynthRealism::kRealistic ? "realistic" : "easy";
+}
+
+SynthRealism ParseSynthRealism(const std::string& text) {
+  if (text == "easy") return SynthRealism::kEasy;
+  if (text == "realistic") return SynthRealism::kRealistic;
+  throw InputError("--realism '" + text + "': unknown (valid: realistic, easy)");
+}
+
 bool SynthOptions::Covered(int k) const {
   const double t = k / 30.0;
   return HasCover() && t >= cover_start_s && t < cover_start_s + cover_seconds;

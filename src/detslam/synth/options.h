@@ -7,6 +7,21 @@
 
 namespace detslam {
 
+// How close to a real Kinect the rendered sensor is.
+//   kEasy: the first generator: depth at the colour image's pose with i.i.d. axial noise, 3-5 %
+//     missing, sharp colour (motion blur only with --blur).
+//   kRealistic: a Kinect-v1-like depth camera (1/8-pixel disparity steps, correlated noise, a fixed
+//     disparity distortion, projector shadow bands, mixed pixels at edges, no return from dark and
+//     grazing surfaces, registration borders) rendered at the depth image's own time, and a colour
+//     camera with a rolling shutter, motion blur of camera and people, lens softness,
+//     signal-dependent noise and a drifting auto-exposure (synth/realistic_sensor.h).
+enum class SynthRealism { kEasy, kRealistic };
+
+// "easy" / "realistic".
+const char* SynthRealismName(SynthRealism realism);
+// Parses a --realism value; throws InputError naming the valid values otherwise.
+SynthRealism ParseSynthRealism(const std::string& text);
+
 struct SynthOptions {
   std::string preset = "walking_xyz";  // camera/people script, one of SynthPresetNames()
   uint64_t seed = 1;                   // seeds textures, people and sensor noise
@@ -19,6 +34,7 @@ struct SynthOptions {
   bool people = true;                  // false: the static twin (same camera path, no people)
   bool motion_blur = false;            // blur colour images along the camera's image motion
   bool sensor_noise = true;            // false: ideal depth and colour (tests of the geometry)
+  SynthRealism realism = SynthRealism::kEasy;  // the sensor model (with sensor_noise)
   double depth_scale_bias = 0.0;       // F: written depth x (1 + F sin^2(pi k / (N - 1))); 0 = off
   int cut_begin = 0;                   // frames cut_begin..cut_end-1 are not written (`--cut A:B`)
   int cut_end = 0;                     // cut_end <= cut_begin (default 0, 0): no cut

@@ -82,7 +82,24 @@ IdealFrame RenderIdeal(const Scene& scene, const std::vector<PersonLook>& looks,
                        const std::vector<PersonState>& people, const PinholeCamera& camera,
                        const Rigid3d& world_from_cam) {
   const int w = camera.width, h = camera.height;
-  IdealFrame out{cv::Mat(h, w, CV_8UC3), cv::Mat(h, w, CV_32F), cv::Mat(h, w, CV_16U)};
+  IdealFrame out{cv::Mat(h, w, CV_8UC3), cv::Mat(h, w, CV_32F), cv::Mat(h, w, CV_16U),
+                 cv::Mat(h, w, CV_8U)};
+  RenderIdealRows(scene, looks, people, camera, world_from_cam, 0, h, &out);
+  return out;
+}
+
+void RenderIdealRows(const Scene& scene, const std::vector<PersonLook>& looks,
+                     const std::vector<PersonState>& people, const PinholeCamera& camera,
+                     const Rigid3d& world_from_cam, int v_begin, int v_end, IdealFrame* out_ptr) {
+  const int w = camera.width, h = camera.height;
+  IdealFrame& out = *out_ptr;
+  CV_Assert(out.bgr.type() == CV_8UC3 && out.bgr.cols == w && out.bgr.rows == h);
+  CV_Assert(out.depth.type() == CV_32F && out.depth.size() == out.bgr.size());
+  CV_Assert(out.ids.type() == CV_16U && out.ids.size() == out.bgr.size());
+  const bool with_ir = !out.ir.empty();
+  CV_Assert(!with_ir || (out.ir.type() == CV_8U && out.ir.size() == out.bgr.size()));
+  v_begin = std::clamp(v_begin, 0, h);
+  v_end = std::clamp(v_end, v_begin, h);
   const Eigen::Matrix3f r_wc = world_from_cam.RotationMatrix().cast<float>();
   const Vec3 c = world_from_cam.translation().cast<float>();
   const Eigen::Matrix3f r_cw = r_wc.transpose();
@@ -136,11 +153,12 @@ IdealFrame RenderIdeal(const Scene& scene, const std::vector<PersonLook>& looks,
   const float cx = static_cast<float>(camera.cx), cy = static_cast<float>(camera.cy);
   const float kInf = std::numeric_limits<float>::infinity();
   constexpr int kRowBlock = 8;
-  const int blocks = (h + kRowBlock - 1) / kRowBlock;
+  const int blocks = (v_end - v_begin + kRowBlock - 1) / kRowBlock;
   cv::parallel_for_(cv::Range(0, blocks), [&](const cv::Range& range) {
     std::vector<int> row_boxes;
     for (int blk = range.start; blk < range.end; ++blk) {
-      for (int v = blk * kRowBlock; v < std::min(h, (blk + 1) * kRowBlock); ++v) {
+      for (int v = v_begin + blk * kRowBlock; v < std::min(v_end, v_begin + (blk + 1) * kRowBlock);
+           ++v) {
         row_boxes.clear();
         for (size_t i = 0; i < box_rects.size(); ++i) {
           if (v >= box_rects[i].v0 && v <= box_rects[i].v1) row_boxes.push_back(static_cast<int>(i));
@@ -148,6 +166,7 @@ IdealFrame RenderIdeal(const Scene& scene, const std::vector<PersonLook>& looks,
         cv::Vec3b* rgb = out.bgr.ptr<cv::Vec3b>(v);
         float* dep = out.depth.ptr<float>(v);
         uint16_t* ids = out.ids.ptr<uint16_t>(v);
+        uchar* irs = with_ir ? out.ir.ptr<uchar>(v) : nullptr;
         for (int u = 0; u < w; ++u) {
           const Vec3 d = r_wc * Vec3((u + 0.f - cx) / fx, (v + 0.f - cy) / fy, 1.f);
           const Vec3 inv(1.f / d.x(), 1.f / d.y(), 1.f / d.z());
@@ -175,13 +194,20 @@ IdealFrame RenderIdeal(const Scene& scene, const std::vector<PersonLook>& looks,
             }
           }
           cv::Vec3f colour(0.f, 0.f, 0.f);
+          float ir_level = 0.f;
           uint16_t id = 0;
           if (best_box >= 0) {
             const SceneBox& b = scene.boxes[best_box];
             const Vec3 p = c + best_t * d;
             float col, row;
             FaceTexel(b, best_axis, p, &col, &row);
-            colour = Bilinear(scene.textures[b.texture[FaceIndex(best_axis, best_hi)]], col, row);
+            const int tex = b.texture[FaceIndex(best_axis, best_hi)];
+            colour = Bilinear(scene.textures[tex], col, row);
+            if (with_ir) {
+              const float gain =
+                  static_cast<size_t>(tex) < scene.ir_gain.size() ? scene.ir_gain[tex] : 1.f;
+              ir_level = gain * (0.114f * colour[0] + 0.587f * colour[1] + 0.299f * colour[2]);
+            }
             Vec3 n = Vec3::Zero();
             n[best_axis] = (best_hi != b.interior) ? 1.f : -1.f;
             const float lambert = std::max(0.f, n.dot((scene.light - p).normalized()));
@@ -207,16 +233,17 @@ IdealFrame RenderIdeal(const Scene& scene, const std::vector<PersonLook>& looks,
             best_t = t_hit;
             id = static_cast<uint16_t>(bb.id);
             colour = Bilinear(sp.bgr, scol, srow) * (0.9f + 0.1f * std::sqrt(std::max(0.f, 1.f - x * x)));
+            ir_level = 0.114f * colour[0] + 0.587f * colour[1] + 0.299f * colour[2];
           }
           rgb[u] = cv::Vec3b(cv::saturate_cast<uchar>(colour[0]), cv::saturate_cast<uchar>(colour[1]),
                              cv::saturate_cast<uchar>(colour[2]));
           dep[u] = std::isfinite(best_t) ? best_t : 0.f;
           ids[u] = id;
+          if (irs != nullptr) irs[u] = cv::saturate_cast<uchar>(ir_level);
         }
       }
     }
   });
-  return out;
 }
 
 }  // namespace detslam::synth

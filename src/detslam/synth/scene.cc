@@ -5,8 +5,8 @@
 
 namespace detslam::synth {
 
-Scene BuildOfficeScene(uint64_t seed) {
-  SceneBuilder b(seed ^ 0x5CE4EULL);
+Scene BuildOfficeScene(uint64_t seed, const TextureStyle& style) {
+  SceneBuilder b(seed ^ 0x5CE4EULL, style);
   using V = Eigen::Vector3f;
   const SurfaceKind W = SurfaceKind::kWall, F = SurfaceKind::kFloor, C = SurfaceKind::kCeiling;
   // Room shell (6.0 x 5.4 x 2.8 m). Floor is the z-lo face, ceiling the z-hi face.
@@ -60,6 +60,15 @@ Scene BuildOfficeScene(uint64_t seed) {
         SurfaceKind::kPoster);
   b.Box(V(-3.0f, -2.5f, 1.3f), V(-2.97f, -1.8f, 2.0f), W, W, FaceIndex(0, true),
         SurfaceKind::kPoster);
+  if (style.windows) {
+    // Windows (added last, so the other surfaces keep their textures): a band of high windows
+    // along the far wall, one above the left desk, one above the right cabinet, one in the back.
+    const SurfaceKind G = SurfaceKind::kWindow;
+    b.Box(V(-2.8f, 2.59f, 1.6f), V(2.8f, 2.6f, 2.7f), W, W, FaceIndex(1, false), G);
+    b.Box(V(-3.0f, -1.5f, 1.8f), V(-2.99f, 0.9f, 2.5f), W, W, FaceIndex(0, true), G);
+    b.Box(V(2.99f, -0.9f, 1.8f), V(3.0f, 0.3f, 2.5f), W, W, FaceIndex(0, false), G);
+    b.Box(V(-2.7f, -2.8f, 1.0f), V(-1.3f, -2.79f, 2.5f), W, W, FaceIndex(1, true), G);
+  }
   return b.Take();
 }
 
@@ -67,11 +76,11 @@ Scene BuildOfficeScene(uint64_t seed) {
 
 namespace detslam::synth {
 
-Scene BuildSceneForPreset(const std::string& preset, uint64_t seed) {
+Scene BuildSceneForPreset(const std::string& preset, uint64_t seed, const TextureStyle& style) {
   RequireSynthPreset(preset);
-  if (preset == "loop_long") return BuildLargeOfficeScene(seed);
-  if (preset == "lookalike") return BuildLookalikeScene(seed).scene;
-  return BuildOfficeScene(seed);
+  if (preset == "loop_long") return BuildLargeOfficeScene(seed, style);
+  if (preset == "lookalike") return BuildLookalikeScene(seed, style).scene;
+  return BuildOfficeScene(seed, style);
 }
 
 }  // namespace detslam::synth

@@ -29,6 +29,7 @@ struct SceneBox {
 struct Scene {
   std::vector<SceneBox> boxes;            // boxes[0] is the room shell
   std::vector<cv::Mat> textures;          // CV_8UC3, kTexelsPerMetre texels per metre
+  std::vector<float> ir_gain;             // per texture: InfraredGain of its kind (missing = 1)
   Eigen::Vector3f light{0.f, 0.f, 2.6f};  // point light position (world)
   float ambient = 0.45f;                  // ambient share of the shading
 };
@@ -45,11 +46,11 @@ inline void FaceTexel(const SceneBox& box, int axis, const Eigen::Vector3f& p, f
 }
 
 // Builds the office room; textures are seeded from `seed` (one forked generator per surface).
-Scene BuildOfficeScene(uint64_t seed);
+Scene BuildOfficeScene(uint64_t seed, const TextureStyle& style = {});
 
 // A large office (12.6 x 8.4 x 2.8 m) for the loop_long preset: the walls lined with shelves,
 // cabinets, cardboard boxes and posters (a seeded layout), the middle free for the camera.
-Scene BuildLargeOfficeScene(uint64_t seed);
+Scene BuildLargeOfficeScene(uint64_t seed, const TextureStyle& style = {});
 
 // The lookalike preset's room (12.8 x 5.0 x 2.8 m): two parts along the far wall (y = 2.6) with
 // the same furnishings' textures in different layouts, and a neutral stretch between them.
@@ -61,9 +62,10 @@ struct LookalikeScene {
   static constexpr float kFirstPartMaxX = -0.9f;  // the first part lies at x < this (world)
   static constexpr float kSecondPartMinX = 0.9f;  // the second part lies at x > this (world)
 };
-LookalikeScene BuildLookalikeScene(uint64_t seed);
+LookalikeScene BuildLookalikeScene(uint64_t seed, const TextureStyle& style = {});
 
 // The room of a preset (the office for the TUM-like presets and `loop`).
-Scene BuildSceneForPreset(const std::string& preset, uint64_t seed);
+Scene BuildSceneForPreset(const std::string& preset, uint64_t seed,
+                          const TextureStyle& style = {});
 
 }  // namespace detslam::synth

@@ -23,7 +23,8 @@ std::array<int, 6> SceneBuilder::Textures(const Eigen::Vector3f& extent, Surface
       if (face == special_face) kind = special;
       Rng surface_rng = rng_.Fork(static_cast<uint64_t>(scene_.textures.size()) + 1);
       faces[face] = static_cast<int>(scene_.textures.size());
-      scene_.textures.push_back(MakeSurfaceTexture(kind, w, h, surface_rng));
+      scene_.textures.push_back(MakeSurfaceTexture(kind, w, h, surface_rng, style_));
+      scene_.ir_gain.push_back(InfraredGain(kind));
     }
   }
   return faces;

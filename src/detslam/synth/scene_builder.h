@@ -15,7 +15,8 @@ namespace detslam::synth {
 
 class SceneBuilder {
  public:
-  explicit SceneBuilder(uint64_t seed) : rng_(seed) {}
+  explicit SceneBuilder(uint64_t seed, const TextureStyle& style = {})
+      : rng_(seed), style_(style) {}
 
   // Adds a box whose faces use `sides` texture, the top (+z) face `top`; `special_face` (if >= 0)
   // uses `special`. Returns the box's index.
@@ -43,6 +44,7 @@ class SceneBuilder {
 
  private:
   Rng rng_;
+  TextureStyle style_;
   Scene scene_;
 };
 

@@ -195,8 +195,8 @@ std::vector<Item> LookalikeItems(Rng& rng) {
 
 }  // namespace
 
-Scene BuildLargeOfficeScene(uint64_t seed) {
-  SceneBuilder b(seed ^ 0x1A26EULL);
+Scene BuildLargeOfficeScene(uint64_t seed, const TextureStyle& style) {
+  SceneBuilder b(seed ^ 0x1A26EULL, style);
   Rng layout(seed ^ 0x1A40FULL);
   const float hx = 6.3f, hy = 4.2f;
   b.Box(V(-hx, -hy, 0.f), V(hx, hy, 2.8f), SurfaceKind::kWall, SurfaceKind::kCeiling,
@@ -207,11 +207,20 @@ Scene BuildLargeOfficeScene(uint64_t seed) {
     const float half = wall.axis == 1 ? hx : hy;
     FurnishWall(b, layout, wall, -half + 0.75f, half - 0.75f);
   }
+  if (style.windows) {
+    // High windows above the furnishings along both long walls (added last, so the other
+    // surfaces keep their textures).
+    const SurfaceKind W = SurfaceKind::kWall, G = SurfaceKind::kWindow;
+    for (const float s : {-4.5f, -1.0f, 2.5f}) {
+      b.Box(V(s, -hy, 2.15f), V(s + 2.0f, -hy + 0.01f, 2.7f), W, W, FaceIndex(1, true), G);
+      b.Box(V(s, hy - 0.01f, 2.15f), V(s + 2.0f, hy, 2.7f), W, W, FaceIndex(1, false), G);
+    }
+  }
   return b.Take();
 }
 
-LookalikeScene BuildLookalikeScene(uint64_t seed) {
-  SceneBuilder b(seed ^ 0x100CA1EULL);
+LookalikeScene BuildLookalikeScene(uint64_t seed, const TextureStyle& style) {
+  SceneBuilder b(seed ^ 0x100CA1EULL, style);
   Rng layout(seed ^ 0x1A7E5ULL);
   // A far, high light: nearly the same shading everywhere along the far wall, so that an item
   // looks the same in both parts.

@@ -73,9 +73,9 @@ void AddColourNoise(cv::Mat* bgr, const SensorModel& model, uint64_t seed, int f
   });
 }
 
-void ApplyMotionBlur(cv::Mat* bgr, cv::Point2f shift_px) {
+cv::Mat MotionBlurKernel(cv::Point2f shift_px) {
   const float len = std::hypot(shift_px.x, shift_px.y);
-  if (len < 0.75f) return;
+  if (!(len >= 0.75f)) return cv::Mat();
   const int half = static_cast<int>(std::ceil(len / 2.0f));
   const int size = 2 * half + 1;
   cv::Mat kernel = cv::Mat::zeros(size, size, CV_32F);
@@ -87,6 +87,12 @@ void ApplyMotionBlur(cv::Mat* bgr, cv::Point2f shift_px) {
     kernel.at<float>(y, x) += 1.f;
   }
   kernel /= cv::sum(kernel)[0];
+  return kernel;
+}
+
+void ApplyMotionBlur(cv::Mat* bgr, cv::Point2f shift_px) {
+  const cv::Mat kernel = MotionBlurKernel(shift_px);
+  if (kernel.empty()) return;
   cv::filter2D(*bgr, *bgr, -1, kernel, cv::Point(-1, -1), 0, cv::BORDER_REFLECT);
 }
 

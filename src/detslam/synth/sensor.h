@@ -35,6 +35,10 @@ cv::Mat MakeDepth16(const cv::Mat& depth, const PinholeCamera& camera, const Sen
 // Adds Gaussian colour noise in place.
 void AddColourNoise(cv::Mat* bgr, const SensorModel& model, uint64_t seed, int frame);
 
+// Kernel of a linear motion blur along `shift_px` (pixels moved during the exposure), normalised;
+// empty if the motion is shorter than 0.75 px (no visible blur).
+cv::Mat MotionBlurKernel(cv::Point2f shift_px);
+
 // Linear motion blur in place: the image moved by `shift_px` (pixels) during the exposure.
 void ApplyMotionBlur(cv::Mat* bgr, cv::Point2f shift_px);
 

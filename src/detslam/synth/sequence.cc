@@ -22,6 +22,18 @@ const SynthOptions& Validated(const SynthOptions& options) {
 
 }  // namespace
 
+synth::TextureStyle SynthTextureStyle(SynthRealism realism) {
+  synth::TextureStyle style;
+  // Realistic rooms: walls, floor and ceiling with a quarter of the easy mode's marks. Chosen so
+  // that FAST corners per frame fall inside the real TUM frames' range (../shared/data; the
+  // realism test checks it), not on any SLAM result.
+  if (realism == SynthRealism::kRealistic) {
+    style.room_clutter = kRealisticRoomClutter;
+    style.windows = true;
+  }
+  return style;
+}
+
 PinholeCamera SynthCamera() {
   PinholeCamera cam;
   cam.width = 640;
@@ -59,7 +71,8 @@ SyntheticSequence::SyntheticSequence(const SynthOptions& options)
     : options_(Validated(options)),
       frames_(SynthFrameCount(options)),
       camera_(SynthCamera()),
-      scene_(synth::BuildSceneForPreset(options.preset, options.SceneSeed())),
+      scene_(synth::BuildSceneForPreset(options.preset, options.SceneSeed(),
+                                        SynthTextureStyle(options.realism))),
       path_(options.preset, options.seed),
       people_(options.preset, options.seed) {
   if (!options_.people_dir.empty()) {
@@ -78,11 +91,61 @@ Timestamp SyntheticSequence::StampOf(int k) const {
 }
 
 Timestamp SyntheticSequence::DepthStampOf(int k) const {
-  // The depth image arrives 2-9 ms after the colour image, varying per frame (like the Kinect's
-  // unsynchronised streams in TUM RGB-D), always well inside the 0.02 s association window.
+  // The depth image arrives a few milliseconds after the colour image, varying per frame (like the
+  // Kinect's unsynchronised streams in TUM RGB-D), inside the 0.02 s association window: 2-9 ms
+  // in the easy mode (where depth is still rendered at the colour image's pose), 2-17 ms in the
+  // realistic one (rendered at its own time).
   const uint64_t h = synth::Mix64(options_.seed ^ (static_cast<uint64_t>(k) * 0x51ED27ULL));
-  const int64_t offset_us = 2000 + static_cast<int64_t>(h % 7001);
+  const int64_t spread_us = options_.realism == SynthRealism::kRealistic ? 15001 : 7001;
+  const int64_t offset_us = 2000 + static_cast<int64_t>(h % spread_us);
   return Timestamp{StampOf(k).ns + offset_us * 1000};
+}
+
+synth::IdealFrame SyntheticSequence::RenderRollingShutter(double t) const {
+  const int w = camera_.width, h = camera_.height;
+  synth::IdealFrame out{cv::Mat(h, w, CV_8UC3), cv::Mat(h, w, CV_32F), cv::Mat(h, w, CV_16U),
+                        cv::Mat()};
+  const int bands = std::clamp(colour_camera_.shutter_bands, 1, h);
+  auto people_at = [&](double time) {
+    return options_.people ? people_.At(time) : std::vector<synth::PersonState>{};
+  };
+  for (int b = 0; b < bands; ++b) {
+    const int v0 = b * h / bands, v1 = (b + 1) * h / bands;
+    // The middle row is exposed at the frame's stamp (its ground-truth pose).
+    const double tb = t + ((v0 + v1) * 0.5 - h * 0.5) / h * colour_camera_.readout_s;
+    synth::RenderIdealRows(scene_, looks_, people_at(tb), camera_, path_.WorldFromCam(tb), v0, v1,
+                           &out);
+  }
+  // Motion blur: the camera's image motion at the median depth for the static scene, and each
+  // person's own image motion (body centre) over the person's pixels.
+  const double half = 0.5 * colour_camera_.exposure_s;
+  const Rigid3d a = path_.WorldFromCam(t - half), b = path_.WorldFromCam(t + half);
+  auto shift_of = [&](const Eigen::Vector3d& pa, const Eigen::Vector3d& pb) {
+    const Eigen::Vector3d ca = a.Inverse() * pa, cb = b.Inverse() * pb;
+    if (ca.z() < 0.1 || cb.z() < 0.1) return cv::Point2f(0.f, 0.f);
+    const Eigen::Vector2d ua = camera_.Project(ca), ub = camera_.Project(cb);
+    return cv::Point2f(static_cast<float>(ub.x() - ua.x()), static_cast<float>(ub.y() - ua.y()));
+  };
+  std::vector<float> z(out.depth.begin<float>(), out.depth.end<float>());
+  std::nth_element(z.begin(), z.begin() + z.size() / 2, z.end());
+  const double zm = std::max(0.5f, z[z.size() / 2]);
+  const Eigen::Vector3d centre = path_.WorldFromCam(t) * Eigen::Vector3d(0, 0, zm);
+  const cv::Mat sharp = out.bgr.clone();
+  synth::ApplyMotionBlur(&out.bgr, shift_of(centre, centre));
+  if (options_.people) {
+    const std::vector<synth::PersonState> pa = people_.At(t - half), pb = people_.At(t + half);
+    for (size_t i = 0; i < pa.size() && i < pb.size(); ++i) {
+      const Eigen::Vector3d up(0, 0, 0.5 * pa[i].height);
+      const cv::Point2f shift = shift_of(pa[i].foot + up, pb[i].foot + up);
+      cv::Mat mask = out.ids == pa[i].id;
+      const int grow = static_cast<int>(std::ceil(std::hypot(shift.x, shift.y) / 2.0f));
+      if (grow > 0)
+        cv::dilate(mask, mask, cv::getStructuringElement(cv::MORPH_RECT,
+                                                         cv::Size(2 * grow + 1, 2 * grow + 1)));
+      synth::BlurRegion(sharp, mask, shift, &out.bgr);
+    }
+  }
+  return out;
 }
 
 Rigid3d SyntheticSequence::WorldFromCam(int k) const {
@@ -101,6 +164,8 @@ SynthFrame SyntheticSequence::Render(int k) const {
   f.stamp = StampOf(k);
   f.depth_stamp = DepthStampOf(k);
   f.world_from_cam = WorldFromCam(k);
+  if (options_.realism == SynthRealism::kRealistic && options_.sensor_noise)
+    return RenderRealistic(std::move(f));
   const std::vector<synth::PersonState> people =
       options_.people ? people_.At(t) : std::vector<synth::PersonState>{};
   synth::IdealFrame ideal = synth::RenderIdeal(scene_, looks_, people, camera_, f.world_from_cam);
@@ -135,6 +200,42 @@ SynthFrame SyntheticSequence::Render(int k) const {
   const double scale = DepthScaleOf(k);
   const cv::Mat sensed = scale == 1.0 ? ideal.depth : cv::Mat(ideal.depth * scale);
   f.depth16 = synth::MakeDepth16(sensed, camera_, sensor_, options_.seed, k, options_.sensor_noise);
+  FillInstances(&f);
+  return f;
+}
+
+SynthFrame SyntheticSequence::RenderRealistic(SynthFrame f) const {
+  const int k = f.index;
+  const double t = static_cast<double>(k) / camera_.fps;
+  synth::IdealFrame colour = RenderRollingShutter(t);
+  f.bgr = colour.bgr;
+  f.true_depth = colour.depth;
+  f.instance_mask = colour.ids;
+  // The depth camera's own exposure, at the depth image's stamp.
+  const double td = SecondsOf(f.depth_stamp);
+  synth::IdealFrame ideal =
+      synth::RenderIdeal(scene_, looks_, options_.people ? people_.At(td) : std::vector<synth::PersonState>{},
+                         camera_, path_.WorldFromCam(td));
+  if (options_.Covered(k)) {
+    f.bgr.setTo(cv::Scalar::all(0));
+    ideal.depth.setTo(0.0f);
+    f.instance_mask.setTo(0);
+  } else {
+    synth::ApplyColourCamera(&f.bgr, colour_camera_, synth::ExposureGain(colour_camera_, options_.seed, t),
+                             options_.seed, k);
+  }
+  const double scale = DepthScaleOf(k);
+  const cv::Mat sensed = scale == 1.0 ? ideal.depth : cv::Mat(ideal.depth * scale);
+  // The device's fixed distortion belongs to the scene's recording setup (same in every sequence
+  // of a scene seed), the noise to the sequence.
+  f.depth16 = synth::MakeKinectDepth16(sensed, ideal.ir, camera_, kinect_, options_.SceneSeed() * 977 + 5,
+                                       options_.seed, k);
+  FillInstances(&f);
+  return f;
+}
+
+void SyntheticSequence::FillInstances(SynthFrame* frame) {
+  SynthFrame& f = *frame;
   // Instances: bounding boxes of the visible mask pixels.
   std::map<int, SynthInstance> found;
   for (int v = 0; v < f.instance_mask.rows; ++v) {
@@ -152,7 +253,6 @@ SynthFrame SyntheticSequence::Render(int k) const {
     }
   }
   for (auto& [id, in] : found) f.instances.push_back(in);
-  return f;
 }
 
 }  // namespace detslam

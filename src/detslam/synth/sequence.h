@@ -13,10 +13,17 @@
 #include "detslam/synth/camera_path.h"
 #include "detslam/synth/options.h"
 #include "detslam/synth/people.h"
+#include "detslam/synth/realistic_sensor.h"
+#include "detslam/synth/renderer.h"
 #include "detslam/synth/scene.h"
 #include "detslam/synth/sensor.h"
+#include "detslam/synth/texture.h"
 
 namespace detslam {
+
+// How busy the room's surfaces are in a realism mode.
+constexpr double kRealisticRoomClutter = 0.25;
+synth::TextureStyle SynthTextureStyle(SynthRealism realism);
 
 // The TUM fr3 (Kinect, Freiburg 3) camera: 640x480, fx 535.4, fy 539.2, cx 320.1, cy 247.6, no
 // distortion, depth 5000 per metre, 30 Hz, bf 40 (baseline 0.0747 m).
@@ -73,6 +80,16 @@ class SyntheticSequence {
   static constexpr int64_t kEpochNs = 1000000000LL * 1000000000LL;
 
  private:
+  // Colour image at time t with a rolling shutter (bands of rows from their own poses and people)
+  // and motion blur of camera and people: the realistic colour camera before exposure and noise.
+  synth::IdealFrame RenderRollingShutter(double t) const;
+  // Render's realistic sensor path for frame f.index (stamps and pose already set).
+  SynthFrame RenderRealistic(SynthFrame f) const;
+  // Instances (boxes, pixel counts) from f's instance mask.
+  static void FillInstances(SynthFrame* f);
+  // Seconds from the first frame of a stamp.
+  static double SecondsOf(Timestamp stamp) { return (stamp.ns - kEpochNs) * 1e-9; }
+
   SynthOptions options_;
   int frames_ = 0;
   PinholeCamera camera_;
@@ -81,6 +98,8 @@ class SyntheticSequence {
   synth::CameraPath path_;
   synth::PeopleScript people_;
   synth::SensorModel sensor_;
+  synth::KinectDepthModel kinect_;
+  synth::ColourCameraModel colour_camera_;
 };
 
 }  // namespace detslam

@@ -123,7 +123,20 @@ void Grain(cv::Mat& img, double amplitude, Rng& rng) {
 
 }  // namespace
 
-cv::Mat MakeSurfaceTexture(SurfaceKind kind, int width_px, int height_px, Rng& rng) {
+float InfraredGain(SurfaceKind kind) {
+  switch (kind) {
+    case SurfaceKind::kWindow:
+      return 0.f;
+    case SurfaceKind::kScreen:
+      return 0.6f;
+    default:
+      return 1.f;
+  }
+}
+
+cv::Mat MakeSurfaceTexture(SurfaceKind kind, int width_px, int height_px, Rng& rng,
+                           const TextureStyle& style) {
+  const double room = style.room_clutter;
   const int w = std::max(2, width_px), h = std::max(2, height_px);
   cv::Mat img;
   cv::Scalar base;
@@ -158,13 +171,16 @@ cv::Mat MakeSurfaceTexture(SurfaceKind kind, int width_px, int height_px, Rng& r
     case SurfaceKind::kPlainWall:
       base = Jitter(cv::Scalar(175, 192, 200), 15, rng);
       break;
+    case SurfaceKind::kWindow:
+      base = Jitter(cv::Scalar(235, 222, 205), 10, rng);
+      break;
   }
   img = cv::Mat(h, w, CV_8UC3, base);
   const double m = kTexelsPerMetre;
   switch (kind) {
     case SurfaceKind::kWall:
       AddLowFrequency(img, 12, rng);
-      Clutter(img, base, 150, 30, rng);
+      Clutter(img, base, 150 * room, 30, rng);
       break;
     case SurfaceKind::kFloor: {
       const int tile = static_cast<int>(0.5 * m);
@@ -173,7 +189,7 @@ cv::Mat MakeSurfaceTexture(SurfaceKind kind, int width_px, int height_px, Rng& r
           cv::rectangle(img, cv::Rect(x, y, tile, tile), Jitter(base, 28, rng), cv::FILLED);
         }
       }
-      Clutter(img, base, 110, 30, rng);
+      Clutter(img, base, 110 * room, 30, rng);
       break;
     }
     case SurfaceKind::kCeiling: {
@@ -186,7 +202,7 @@ cv::Mat MakeSurfaceTexture(SurfaceKind kind, int width_px, int height_px, Rng& r
           cv::rectangle(img, cv::Rect(x, y, tile, tile), Contrasting(base, 40, 70, rng), 2);
         }
       }
-      Clutter(img, base, 80, 30, rng);
+      Clutter(img, base, 80 * room, 30, rng);
       break;
     }
     case SurfaceKind::kWood:
@@ -231,8 +247,27 @@ cv::Mat MakeSurfaceTexture(SurfaceKind kind, int width_px, int height_px, Rng& r
       break;
     case SurfaceKind::kPlainWall:
       AddLowFrequency(img, 10, rng);
-      Clutter(img, base, 8, 25, rng);
+      Clutter(img, base, 8 * room, 25, rng);
       break;
+    case SurfaceKind::kWindow: {
+      // The view outside, out of focus: a few soft darker shapes (buildings, trees) on a bright
+      // sky, then the frames: a border and mullions every 0.6-1.0 m.
+      const int shapes = std::max(1, static_cast<int>(w / m * 2));
+      for (int i = 0; i < shapes; ++i) {
+        const int bw = static_cast<int>(rng.Uniform(0.2, 0.8) * m);
+        const int top = static_cast<int>(rng.Uniform(0.3, 0.8) * h);
+        cv::rectangle(img, cv::Rect(rng.UniformInt(0, w - 1) - bw / 2, top, bw, h - top),
+                      Jitter(cv::Scalar(150, 160, 165), 25, rng), cv::FILLED);
+      }
+      cv::GaussianBlur(img, img, cv::Size(0, 0), 0.06 * m);
+      const cv::Scalar frame = Jitter(cv::Scalar(80, 80, 85), 15, rng);
+      const int bar = std::max(2, static_cast<int>(0.035 * m));
+      cv::rectangle(img, cv::Rect(0, 0, w, h), frame, 2 * bar);
+      const double step = rng.Uniform(0.6, 1.0) * m;
+      for (double x = step; x < w - step / 2; x += step)
+        cv::rectangle(img, cv::Rect(static_cast<int>(x) - bar / 2, 0, bar, h), frame, cv::FILLED);
+      break;
+    }
   }
   Grain(img, 3.0, rng);
   return img;

@@ -39,6 +39,7 @@ std::string Describe(const SynthOptions& o) {
   if (!o.people) os << " --no-people";
   if (!o.people_dir.empty()) os << " --people " << o.people_dir;
   if (o.motion_blur) os << " --blur";
+  if (o.realism != SynthRealism::kEasy) os << " --realism " << SynthRealismName(o.realism);
   if (o.depth_scale_bias != 0.0) os << " --depth-scale-bias " << o.depth_scale_bias;
   if (o.HasCut()) os << " --cut " << o.cut_begin << ":" << o.cut_end;
   if (o.HasCover()) os << " --cover " << o.cover_start_s << ":" << o.cover_seconds;
@@ -61,6 +62,11 @@ int CountFastCorners(const cv::Mat& bgr) {
   std::vector<cv::KeyPoint> kps;
   cv::FAST(gray, kps, 20, true);
   return static_cast<int>(kps.size());
+}
+
+double MissingDepthFraction(const cv::Mat& depth) {
+  CV_Assert(depth.channels() == 1 && !depth.empty());
+  return 1.0 - static_cast<double>(cv::countNonZero(depth)) / static_cast<double>(depth.total());
 }
 
 SynthStats WriteSequence(const SynthOptions& options, const std::string& out_dir) {
@@ -87,7 +93,7 @@ SynthStats WriteSequence(const SynthOptions& options, const std::string& out_dir
       << "# x y w h: bounding box of the visible pixels (pixels, top-left origin)\n";
   Trajectory gt;
   SynthStats stats;
-  double coverage_sum = 0, fast_sum = 0;
+  double coverage_sum = 0, fast_sum = 0, missing_sum = 0;
   for (int k = 0; k < seq.size(); ++k) {
     // --cut: the camera keeps moving through the cut frames, none of their files are written.
     if (options.HasCut() && k >= options.cut_begin && k < options.cut_end) continue;
@@ -116,6 +122,7 @@ SynthStats WriteSequence(const SynthOptions& options, const std::string& out_dir
     const auto measure_start = Clock::now();
     if (k % 5 == 0) {
       fast_sum += CountFastCorners(f.bgr);
+      missing_sum += MissingDepthFraction(f.depth16);
       ++stats.sampled_frames;
     }
     const double measure = Since(measure_start);
@@ -139,6 +146,7 @@ SynthStats WriteSequence(const SynthOptions& options, const std::string& out_dir
   stats.total_fps = stats.frames / std::max(1e-9, stats.total_seconds);
   stats.mean_coverage = coverage_sum / std::max(1, stats.frames);
   stats.mean_fast_corners = fast_sum / std::max(1, stats.sampled_frames);
+  stats.mean_missing_depth = missing_sum / std::max(1, stats.sampled_frames);
   spdlog::info("synth {}: wrote {} frames to {} (render {:.1f} fps, total {:.1f} fps)",
                options.preset, stats.frames, out_dir, stats.render_fps, stats.total_fps);
   return stats;

@@ -23,7 +23,8 @@ struct SynthStats {
   double total_fps = 0;          // frames / total_seconds
   double mean_fast_corners = 0;  // mean cv::FAST (threshold 20, non-max) corners, sampled frames
   double mean_coverage = 0;      // mean fraction of pixels covered by people, all frames
-  int sampled_frames = 0;        // frames the FAST count was taken on
+  double mean_missing_depth = 0; // mean fraction of pixels without depth, sampled frames
+  int sampled_frames = 0;        // frames the FAST count and missing depth were taken on
 };
 
 // Renders and writes the sequence into `out_dir` (created if missing; existing files of the same
@@ -33,5 +34,8 @@ SynthStats WriteSequence(const SynthOptions& options, const std::string& out_dir
 
 // Number of FAST corners (threshold 20, non-max suppression) in a BGR image.
 int CountFastCorners(const cv::Mat& bgr);
+
+// Fraction of the pixels of a depth image (any single-channel type) that are 0 (missing).
+double MissingDepthFraction(const cv::Mat& depth);
 
 }  // namespace detslam
