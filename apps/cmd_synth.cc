@@ -19,6 +19,7 @@ void AddSynthCommand(CLI::App& app) {
   auto cut = std::make_shared<std::string>();
   auto cover = std::make_shared<std::string>();
   auto realism = std::make_shared<std::string>("easy");
+  auto realism_off = std::make_shared<std::string>();
   std::string presets;
   for (const auto& p : SynthPresetNames()) presets += (presets.empty() ? "" : ", ") + p;
   cmd->add_option("--preset", opts->preset, "Camera/people script: " + presets)
@@ -42,6 +43,11 @@ void AddSynthCommand(CLI::App& app) {
                   "pixels, no return from dark or grazing surfaces, registration borders; rolling "
                   "shutter, motion blur, lens softness, photon noise, exposure drift)")
       ->capture_default_str();
+  std::string effects;
+  for (const auto& e : SynthRealismEffects()) effects += (effects.empty() ? "" : ", ") + e;
+  cmd->add_option("--realism-off", *realism_off,
+                  "Comma-separated effects of the realistic mode to switch off, to measure what "
+                  "each costs: " + effects);
   cmd->add_option("--depth-scale-bias", opts->depth_scale_bias,
                   "Depth miscalibration F: written depth x 1 + F sin^2(pi k / (frames - 1)) (rises "
                   "to 1 + F mid-sequence, back to 1 at the end; ground truth stays true); 0 = off")
@@ -56,9 +62,10 @@ void AddSynthCommand(CLI::App& app) {
   cmd->add_option("--out", *out_dir, "Output folder")->required();
   cmd->add_option("--stats-json", *stats_json,
                   "Write timing and content statistics (fps, FAST corners, coverage) as JSON");
-  cmd->callback([opts, out_dir, stats_json, no_people, cut, cover, realism] {
+  cmd->callback([opts, out_dir, stats_json, no_people, cut, cover, realism, realism_off] {
     opts->people = !*no_people;
     opts->realism = ParseSynthRealism(*realism);
+    if (!realism_off->empty()) ParseSynthRealismOff(*realism_off, opts.get());
     if (!cut->empty()) ParseSynthCut(*cut, opts.get());
     if (!cover->empty()) ParseSynthCover(*cover, opts.get());
     RequireSynthPreset(opts->preset);
@@ -76,6 +83,7 @@ void AddSynthCommand(CLI::App& app) {
                           {"people_dir", opts->people_dir},
                           {"motion_blur", opts->motion_blur},
                           {"realism", SynthRealismName(opts->realism)},
+                          {"realism_off", opts->realism_off},
                           {"depth_scale_bias", opts->depth_scale_bias},
                           {"cut", cut_frames},
                           {"cover", opts->HasCover() ? nlohmann::json::array(

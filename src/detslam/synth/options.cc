@@ -82,8 +82,40 @@ bool SynthOptions::Check(std::string* error) const {
       os << "; ";
     }
   }
+  if (!realism_off.empty() && realism != SynthRealism::kRealistic)
+    os << "--realism-off needs --realism realistic; ";
   if (error != nullptr) *error = os.str();
   return os.str().empty();
+}
+
+const std::vector<std::string>& SynthRealismEffects() {
+  static const std::vector<std::string> kEffects = {"timing", "shutter",      "blur",
+                                                    "colour", "quantisation", "noise",
+                                                    "distortion", "dropouts", "rooms"};
+  return kEffects;
+}
+
+bool SynthOptions::RealismOff(const std::string& effect) const {
+  return std::find(realism_off.begin(), realism_off.end(), effect) != realism_off.end();
+}
+
+void ParseSynthRealismOff(const std::string& text, SynthOptions* options) {
+  const auto& valid = SynthRealismEffects();
+  std::vector<std::string> out;
+  size_t start = 0;
+  while (start <= text.size()) {
+    const size_t comma = std::min(text.find(',', start), text.size());
+    const std::string name = text.substr(start, comma - start);
+    if (std::find(valid.begin(), valid.end(), name) == valid.end()) {
+      std::string list;
+      for (const auto& v : valid) list += (list.empty() ? "" : ", ") + v;
+      throw InputError("--realism-off '" + text + "': unknown effect '" + name + "' (valid: " +
+                       list + ")");
+    }
+    if (std::find(out.begin(), out.end(), name) == out.end()) out.push_back(name);
+    start = comma + 1;
+  }
+  options->realism_off = out;
 }
 
 const char* SynthRealismName(SynthRealism realism) {

@@ -17,6 +17,22 @@ namespace detslam {
 //     signal-dependent noise and a drifting auto-exposure (synth/realistic_sensor.h).
 enum class SynthRealism { kEasy, kRealistic };
 
+// The realistic mode's effects that --realism-off can switch off, in a fixed order:
+//   timing        depth rendered at the colour image's time instead of its own stamp
+//   shutter       global shutter instead of the rolling one
+//   blur          no motion blur
+//   colour        no lens softness, colour noise or exposure drift
+//   quantisation  continuous disparity instead of 1/8-pixel steps
+//   noise         no random disparity noise
+//   distortion    no fixed disparity distortion
+//   dropouts      every pixel with a surface in range has depth (no borders, shadows, edges,
+//                 grazing, dark or glass dropouts, holes)
+//   rooms         the easy mode's busy walls and no windows
+const std::vector<std::string>& SynthRealismEffects();
+// Parses a comma-separated --realism-off list into options->realism_off; throws InputError
+// naming an unknown effect.
+void ParseSynthRealismOff(const std::string& text, struct SynthOptions* options);
+
 // "easy" / "realistic".
 const char* SynthRealismName(SynthRealism realism);
 // Parses a --realism value; throws InputError naming the valid values otherwise.
@@ -35,6 +51,10 @@ struct SynthOptions {
   bool motion_blur = false;            // blur colour images along the camera's image motion
   bool sensor_noise = true;            // false: ideal depth and colour (tests of the geometry)
   SynthRealism realism = SynthRealism::kEasy;  // the sensor model (with sensor_noise)
+  // Effects of the realistic mode switched off, to measure what each costs (`--realism-off`):
+  // names from SynthRealismEffects().
+  std::vector<std::string> realism_off;
+  bool RealismOff(const std::string& effect) const;
   double depth_scale_bias = 0.0;       // F: written depth x (1 + F sin^2(pi k / (N - 1))); 0 = off
   int cut_begin = 0;                   // frames cut_begin..cut_end-1 are not written (`--cut A:B`)
   int cut_end = 0;                     // cut_end <= cut_begin (default 0, 0): no cut

@@ -92,8 +92,9 @@ cv::Mat MakeKinectDepth16(const cv::Mat& depth, const cv::Mat& infrared, const P
   const int w = depth.cols, h = depth.rows;
   const double fb = camera.fx * model.baseline;
   const uint64_t f = static_cast<uint64_t>(frame);
-  const cv::Mat shadow = ProjectorShadow(depth, camera.fx, model.baseline,
-                                         model.shadow_tolerance_px);
+  const cv::Mat shadow = model.shadows ? ProjectorShadow(depth, camera.fx, model.baseline,
+                                                         model.shadow_tolerance_px)
+                                        : cv::Mat::zeros(depth.size(), CV_8U);
   const SmoothField bias(device_seed, -1, model.bias_cell_px, 11);
   const SmoothField correlated(seed, frame, model.correlation_px, 12);
   // Holes of irregular shape: two scales of random field.

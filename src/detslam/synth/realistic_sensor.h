@@ -30,6 +30,7 @@ struct KinectDepthModel {
   double min_depth = 0.45;          // nearer: missing (metres)
   double max_depth = 8.0;           // farther: missing (metres)
   double shadow_tolerance_px = 0.3; // projector occlusion test slack (pixels)
+  bool shadows = true;              // false: the projector lights everything (ablations)
   // The depth image registered to the colour camera has no data along its borders (the two
   // cameras' fields of view differ): columns and rows without depth.
   int border_left = 20, border_right = 24, border_top = 10, border_bottom = 8;

@@ -22,7 +22,8 @@ const SynthOptions& Validated(const SynthOptions& options) {
 
 }  // namespace
 
-synth::TextureStyle SynthTextureStyle(SynthRealism realism) {
+synth::TextureStyle SynthTextureStyle(const SynthOptions& options) {
+  const SynthRealism realism = options.RealismOff("rooms") ? SynthRealism::kEasy : options.realism;
   synth::TextureStyle style;
   // Realistic rooms: walls, floor and ceiling with a quarter of the easy mode's marks. Chosen so
   // that FAST corners per frame fall inside the real TUM frames' range (../shared/data; the
@@ -72,7 +73,7 @@ SyntheticSequence::SyntheticSequence(const SynthOptions& options)
       frames_(SynthFrameCount(options)),
       camera_(SynthCamera()),
       scene_(synth::BuildSceneForPreset(options.preset, options.SceneSeed(),
-                                        SynthTextureStyle(options.realism))),
+                                        SynthTextureStyle(options))),
       path_(options.preset, options.seed),
       people_(options.preset, options.seed) {
   if (!options_.people_dir.empty()) {
@@ -81,6 +82,25 @@ SyntheticSequence::SyntheticSequence(const SynthOptions& options)
     for (int i = 0; i < std::max(1, people_.count()); ++i) {
       looks_.push_back(synth::MakeProceduralPerson(options_.seed * 131 + static_cast<uint64_t>(i)));
     }
+  }
+  // Realistic effects switched off for ablations.
+  if (options_.RealismOff("shutter")) colour_camera_.readout_s = 0;
+  if (options_.RealismOff("blur")) colour_camera_.exposure_s = 0;
+  if (options_.RealismOff("colour")) {
+    colour_camera_.psf_sigma = colour_camera_.read_sigma = colour_camera_.shot_gain = 0;
+    colour_camera_.exposure_drift = 0;
+  }
+  if (options_.RealismOff("quantisation")) kinect_.disparity_step = 1e-6;
+  if (options_.RealismOff("noise")) kinect_.sigma_white = kinect_.sigma_correlated = 0;
+  if (options_.RealismOff("distortion")) kinect_.bias_amplitude = 0;
+  if (options_.RealismOff("dropouts")) {
+    kinect_.border_left = kinect_.border_right = kinect_.border_top = kinect_.border_bottom = 0;
+    kinect_.shadows = false;
+    kinect_.edge_dropout = kinect_.edge_mixed = 0;
+    kinect_.grazing_cos_lo = kinect_.dark_lo = -2;
+    kinect_.grazing_cos_hi = kinect_.dark_hi = -1;
+    kinect_.hole_fraction = 1e-12;
+    kinect_.speckle_dropout = 0;
   }
 }
 
@@ -212,7 +232,7 @@ SynthFrame SyntheticSequence::RenderRealistic(SynthFrame f) const {
   f.true_depth = colour.depth;
   f.instance_mask = colour.ids;
   // The depth camera's own exposure, at the depth image's stamp.
-  const double td = SecondsOf(f.depth_stamp);
+  const double td = options_.RealismOff("timing") ? t : SecondsOf(f.depth_stamp);
   synth::IdealFrame ideal =
       synth::RenderIdeal(scene_, looks_, options_.people ? people_.At(td) : std::vector<synth::PersonState>{},
                          camera_, path_.WorldFromCam(td));

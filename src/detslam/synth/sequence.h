@@ -23,7 +23,7 @@ namespace detslam {
 
 // How busy the room's surfaces are in a realism mode.
 constexpr double kRealisticRoomClutter = 0.25;
-synth::TextureStyle SynthTextureStyle(SynthRealism realism);
+synth::TextureStyle SynthTextureStyle(const SynthOptions& options);
 
 // The TUM fr3 (Kinect, Freiburg 3) camera: 640x480, fx 535.4, fy 539.2, cx 320.1, cy 247.6, no
 // distortion, depth 5000 per metre, 30 Hz, bf 40 (baseline 0.0747 m).

@@ -47,6 +47,57 @@ TEST(SynthOptionsTest, UnknownPresetIsAnInputErrorListingValidOnes) {
   EXPECT_EQ(SynthPresetNames().size(), 10u);
 }
 
+TEST(SynthOptionsTest, RealismAndItsAblationsParseOrNameTheBadValue) {
+  EXPECT_EQ(ParseSynthRealism("easy"), SynthRealism::kEasy);
+  EXPECT_EQ(ParseSynthRealism("realistic"), SynthRealism::kRealistic);
+  EXPECT_STREQ(SynthRealismName(SynthRealism::kRealistic), "realistic");
+  try {
+    ParseSynthRealism("kinect");
+    FAIL() << "expected InputError";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("realistic, easy"), std::string::npos) << e.what();
+  }
+  SynthOptions o = Opts("static");
+  ParseSynthRealismOff("noise,timing,noise", &o);
+  EXPECT_EQ(o.realism_off, (std::vector<std::string>{"noise", "timing"}));
+  EXPECT_TRUE(o.RealismOff("timing"));
+  EXPECT_FALSE(o.RealismOff("blur"));
+  std::string error;
+  EXPECT_FALSE(o.Check(&error)) << "ablations need the realistic mode";
+  EXPECT_NE(error.find("--realism-off"), std::string::npos);
+  o.realism = SynthRealism::kRealistic;
+  EXPECT_TRUE(o.Check(&error)) << error;
+  for (const std::string bad : {"", "noise,", "Noise", "noise,,blur"}) {
+    SynthOptions p = Opts("static");
+    try {
+      ParseSynthRealismOff(bad, &p);
+      FAIL() << "expected InputError for '" << bad << "'";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("dropouts"), std::string::npos) << e.what();
+    }
+  }
+  // Every effect switched off changes the frames, except where the scene leaves it nothing to do.
+  o.frames = 30;
+  o.preset = "walking_xyz";
+  o.realism_off.clear();
+  const SynthFrame full = SyntheticSequence(o).Render(25);
+  for (const std::string& effect : SynthRealismEffects()) {
+    SynthOptions p = o;
+    p.realism_off = {effect};
+    const SynthFrame f = SyntheticSequence(p).Render(25);
+    const bool colour_differs = cv::norm(f.bgr, full.bgr, cv::NORM_INF) > 0;
+    const bool depth_differs = cv::norm(f.depth16, full.depth16, cv::NORM_INF) > 0;
+    EXPECT_TRUE(colour_differs || depth_differs) << effect;
+    const bool colour_effect = effect == "shutter" || effect == "blur" || effect == "colour";
+    if (colour_effect) {
+      EXPECT_TRUE(colour_differs) << effect;
+    }
+    if (effect == "dropouts") {
+      EXPECT_GT(cv::countNonZero(f.depth16), cv::countNonZero(full.depth16) * 1.3);
+    }
+  }
+}
+
 TEST(SynthSequenceTest, DepthBackProjectsOntoSceneSurfaces) {
   SynthOptions o = Opts("static", 3, /*noise=*/false);
   SyntheticSequence seq(o);

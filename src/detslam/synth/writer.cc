@@ -40,6 +40,8 @@ std::string Describe(const SynthOptions& o) {
   if (!o.people_dir.empty()) os << " --people " << o.people_dir;
   if (o.motion_blur) os << " --blur";
   if (o.realism != SynthRealism::kEasy) os << " --realism " << SynthRealismName(o.realism);
+  for (size_t i = 0; i < o.realism_off.size(); ++i)
+    os << (i == 0 ? " --realism-off " : ",") << o.realism_off[i];
   if (o.depth_scale_bias != 0.0) os << " --depth-scale-bias " << o.depth_scale_bias;
   if (o.HasCut()) os << " --cut " << o.cut_begin << ":" << o.cut_end;
   if (o.HasCover()) os << " --cover " << o.cover_start_s << ":" << o.cover_seconds;
