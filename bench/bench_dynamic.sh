@@ -43,6 +43,7 @@ run_eval() {
   shift 2
   "$bin" run --dataset "$ds" --out "$out" --no-progress --models "$models" "$@" >"$out.log" 2>&1 || { cat "$out.log" >&2; return 1; }
   "$bin" eval --gt "$ds/groundtruth.txt" --est "$out/trajectory.txt" --frames "$ds" --json "$out/eval.json" >/dev/null
+  python3 "$here/cross_check_eval.py" "$out/eval.json" || return 1
   python3 - "$out" <<'PY'
 import json, sys
 e = json.load(open(sys.argv[1] + "/eval.json")); r = json.load(open(sys.argv[1] + "/run.json"))
@@ -65,9 +66,13 @@ job() {
   read -r full full_tr < <(run_eval "$seq" "$seq.full" --segmenter "masks:$seq.dnnmasks")
   read -r gt gt_tr < <(run_eval "$seq" "$seq.gt" --segmenter gt)
   # The twin and the default filter with ORB-SLAM3's depth weighting (u_right residual).
-  local twin0 full0
+  local twin0 full0 nopre rawdepth
   read -r twin0 _ < <(run_eval "$seq.twin" "$seq.twin.run0" --segmenter none --set RGBD.DisparitySigma=0)
   read -r full0 _ < <(run_eval "$seq" "$seq.full0" --segmenter "masks:$seq.dnnmasks" --set RGBD.DisparitySigma=0)
+  # The default filter without the pre-mask (dynamic corners dropped only after the ORB spatial
+  # distribution), and with the paper's raw min/max object depth instead of the dominant mode.
+  read -r nopre _ < <(run_eval "$seq" "$seq.fullnopre" --segmenter "masks:$seq.dnnmasks" --set Dynamic.PreMask=false)
+  read -r rawdepth _ < <(run_eval "$seq" "$seq.fullraw" --segmenter "masks:$seq.dnnmasks" --set Dynamic.DominantDepth=false)
   python3 - "$preset" "$seed" "$twin" "$twin_tr" "$full" "$full_tr" "$none" "$none_tr" "$seq.full/run.json" \
       >"$work/rows/${preset}_$seed.main" <<'PY'
 import json, sys
@@ -79,7 +84,7 @@ tr, n = full_tr.split("/")
 ok = "yes" if ratio <= 1.25 and tr == n else "no"
 print(f"| {preset} | {seed} | {float(twin):.1f} ({twin_tr}) | {float(full):.1f} ({full_tr}) | {ratio:.2f} | {ok} | {float(none):.1f} ({none_tr}) | {cov:.0f} |")
 PY
-  printf '| %s | %s | %.1f | %.1f | %.1f | %.1f | %.1f | %.1f | %.1f / %.1f (%.2f) |\n' "$preset" "$seed" "$twin" "$none" "$mask" "$depth" "$full" "$gt" \
+  printf '| %s | %s | %.1f | %.1f | %.1f | %.1f | %.1f | %.1f | %.1f | %.1f | %.1f / %.1f (%.2f) |\n' "$preset" "$seed" "$twin" "$none" "$mask" "$depth" "$full" "$nopre" "$rawdepth" "$gt" \
       "$twin0" "$full0" "$(python3 -c "print($full0 / $twin0)")" >"$work/rows/${preset}_$seed.ablation"
   if [[ " $spread_presets " == *" $preset "* ]]; then
     # Spread: the same twin and filtered runs with the keyframe far-point budget moved by +-20
@@ -183,12 +188,16 @@ done
   echo
   echo "Ablation (ATE RMSE mm). \"+ geometric check\" adds the tracker's check for movers the segmenter"
   echo "missed (on by default; \`--no-geometric-check\` turns it off); the two columns before it run"
-  echo "without it. gt masks: the generator's masks with the default filter. Last column: the static"
+  echo "without it. \"PreMask off\": the default filter with \`--set Dynamic.PreMask=false\` (dynamic"
+  echo "corners dropped after the ORB spatial distribution instead of before it). \"raw min/max depth\": the"
+  echo "default filter with the paper's depth step taken literally, m_obj/M_obj the min/max over every"
+  echo "mask pixel (\`--set Dynamic.DominantDepth=false\`) instead of the dominant depth mode."
+  echo "gt masks: the generator's masks with the default filter. Last column: the static"
   echo "twin and the default filter with ORB-SLAM3's depth weighting (\`--set RGBD.DisparitySigma=0\`:"
   echo "u_right residual with the keypoint's sigma), and their ratio."
   echo
-  echo "| preset | seed | static twin | none | masks only | masks + depth step | + geometric check (default) | gt masks | twin / filter, ORB-SLAM3 depth weighting (ratio) |"
-  echo "|---|---:|---:|---:|---:|---:|---:|---:|---:|"
+  echo "| preset | seed | static twin | none | masks only | masks + depth step | + geometric check (default) | PreMask off | raw min/max depth | gt masks | twin / filter, ORB-SLAM3 depth weighting (ratio) |"
+  echo "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
   printf '%s\n' "$ablation_rows"
   echo
   if [[ -n "$spread_rows" ]]; then

@@ -8,6 +8,13 @@ publish() {  # section file
 m() { python3 "$here/slam_metrics.py" "$@"; }
 mm() { python3 -c "print(f'{float($1)*1000:.1f}')"; }
 progress() { echo "[$bench_name] $*" >&2; }
+# cross_check EVAL_JSON: the same ATE and RPE recomputed by the independent
+# tools/tum_eval_reference.py; a disagreement above 1e-6 m stops the benchmark (the result is
+# deleted too, so that a caller in a background job cannot read it either).
+cross_check() {
+  python3 "$here/cross_check_eval.py" "$1" ||
+    { echo "[bench] cross-check failed: $1" >&2; rm -f "$1"; exit 1; }
+}
 
 run_eval() {  # dataset_dir out_dir [run options...]: sequential run, seed 42, then eval.json
   local ds=$1 o=$2
@@ -16,6 +23,7 @@ run_eval() {  # dataset_dir out_dir [run options...]: sequential run, seed 42, t
     { cat "$o.log"; exit 1; }
   "$bin" eval --gt "$ds/groundtruth.txt" --est "$o/trajectory.txt" --frames "$ds" \
     --json "$o/eval.json" >/dev/null
+  cross_check "$o/eval.json"
 }
 
 # The real people cut-outs and the models from ../shared ($DETSLAM_SHARED overrides): sets people

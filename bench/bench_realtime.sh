@@ -208,6 +208,7 @@ if want long; then
   if [ -f "$work/long_run/trajectory.txt" ]; then
     "$bin" eval --gt "$seq/groundtruth.txt" --est "$work/long_run/trajectory.txt" \
       --json "$work/long_eval.json" >/dev/null 2>&1 &&
+      cross_check "$work/long_eval.json" &&
       ate=$(python3 -c 'import json,sys; print(json.load(open(sys.argv[1]))["ate"]["rmse"])' \
         "$work/long_eval.json")
   fi

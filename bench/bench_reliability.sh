@@ -227,6 +227,7 @@ if want K; then
   if [ -f "$work/soak_run/trajectory.txt" ]; then
     ate=$("$bin" eval --gt "$seq/groundtruth.txt" --est "$work/soak_run/trajectory.txt" \
       --json "$work/soak_eval.json" >/dev/null 2>&1 &&
+      python3 "$here/cross_check_eval.py" "$work/soak_eval.json" &&
       python3 -c "import json,sys; print(f\"{json.load(open(sys.argv[1]))['ate']['rmse']:.4f}\")" \
         "$work/soak_eval.json" || echo "-")
   fi

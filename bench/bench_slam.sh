@@ -43,6 +43,7 @@ run_eval() {  # dataset_dir out_dir [seed [run options...]]
   "$bin" run --dataset "$ds" --out "$o" --seed "$sd" --segmenter none --no-progress "$@" >"$o.log" 2>&1 || { cat "$o.log"; exit 1; }
   set -- "$ds" "$o"
   "$bin" eval --gt "$1/groundtruth.txt" --est "$2/trajectory.txt" --frames "$1" --json "$2/eval.json" >/dev/null
+  python3 "$here/cross_check_eval.py" "$2/eval.json" || exit 1  # independent reference, 1e-6 m
 }
 
 header="| sequence | tracked | ATE RMSE mm | ATE median mm | ATE max mm | RPE trans mm/s | RPE rot deg/s | keyframes | extraction ms (median) | tracking ms (median) | local mapping ms per keyframe (median) |

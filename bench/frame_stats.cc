@@ -8,6 +8,7 @@
 #include <iostream>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
+#include <spdlog/spdlog.h>
 #include <string>
 #include <vector>
 
@@ -28,6 +29,7 @@ nlohmann::json Summary(std::vector<double> v) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  spdlog::set_level(spdlog::level::warn);  // stdout carries the JSON lines only
   int every = 1;
   std::vector<std::string> dirs;
   for (int i = 1; i < argc; ++i) {

@@ -9,6 +9,7 @@
 #include <thread>
 #include <algorithm>
 #include <chrono>
+#include <cstdio>
 
 #include "detslam/core/check.h"
 #include "detslam/eval/evaluate.h"
@@ -41,7 +42,7 @@ struct SlamRun {
 
 SlamRun RunAndEvaluate(const std::string& dataset_dir, const std::string& out_dir, uint64_t seed,
                        bool threaded = false, const std::string& segmenter_spec = "none",
-                       bool mapping_thread = false) {
+                       bool mapping_thread = false, const std::string& models_dir = "") {
   const RgbdDataset dataset = RgbdDataset::Open(dataset_dir, {});
   const Settings settings = PresetForDataset(dataset_dir);
   RunOptions options;
@@ -50,7 +51,7 @@ SlamRun RunAndEvaluate(const std::string& dataset_dir, const std::string& out_di
   options.slam = SlamOptionsFromSettings(settings, seed);
   options.mapping_thread = mapping_thread;
   const std::unique_ptr<Segmenter> segmenter =
-      MakeSegmenter(segmenter_spec, dataset_dir, ResolveSettings(settings).segmenter, "");
+      MakeSegmenter(segmenter_spec, dataset_dir, ResolveSettings(settings).segmenter, models_dir);
   SlamRun run;
   run.summary = Run(dataset, settings, options, nullptr, segmenter.get());
   run.trajectory_path = (fs::path(out_dir) / "trajectory.txt").string();
@@ -132,6 +133,48 @@ TEST(IntegrationSlamDynamic, GroundTruthMasksRemoveThePeople) {
   int frames_with_people = 0;
   for (const FrameReport& r : with_gt.summary.reports) frames_with_people += r.dynamic_instances > 0 ? 1 : 0;
   EXPECT_GT(frames_with_people, 100) << "the filter saw people in too few frames";
+}
+
+// The same with the default dnn segmenter (YOLOX-nano + Yolo-Fastest + person masks from
+// ../shared/models) on people textured with the real TUM cut-outs: every frame tracked, ATE at most
+// 1.5x the static twin's, and without the filter clearly worse. Seed 4 is neither a tuning seed
+// (1-3) nor an evaluation seed (101+) of the benchmarks.
+// DISABLED because it FAILS today (2026-12-04): dnn 3.65 mm against the twin's 2.16 mm (1.69x;
+// ground-truth masks 2.14 mm, no filter 482 mm). The detectors miss a person cut by the left image
+// border (a torso without a head) for frames 114-121, longer than Dynamic.MemoryFrames (3) carries
+// the lost instance, and the pose drifts by up to 3.2 cm while its keypoints count as static.
+// A longer memory fixes this sequence (10 frames: 2.27 mm) but not the tuning seeds (mean over the
+// four walking presets x seeds 1-3: 2.47 / 2.48 / 2.50 mm for 3 / 6 / 10 frames), so the default
+// stays; enable this test with the fix (README, Not done yet).
+TEST(DataSlamDynamic, DISABLED_DnnSegmenterKeepsTheStaticTwinsAccuracy) {
+  DETSLAM_REQUIRE_SHARED("data/people/person_1.png");
+  DETSLAM_REQUIRE_SHARED("models/yolox_nano/yolox_nano.onnx");
+  SynthOptions so;
+  so.preset = "walking_xyz";
+  so.seed = 4;
+  so.frames = 300;
+  so.people_dir = testing::SharedPath("data/people");
+  const std::string seq = TempDir("walking_dnn");
+  WriteSequence(so, seq);
+  so.people = false;
+  const std::string twin = TempDir("walking_dnn_twin");
+  WriteSequence(so, twin);
+  const SlamRun with_dnn = RunAndEvaluate(seq, TempDir("walking_dnn_run"), 42, false, "dnn", false,
+                                          testing::SharedPath("models"));
+  const SlamRun without = RunAndEvaluate(seq, TempDir("walking_dnn_none"), 42, false, "none");
+  const SlamRun static_twin = RunAndEvaluate(twin, TempDir("walking_dnn_twin_run"), 42);
+  EXPECT_EQ(with_dnn.summary.tracked, with_dnn.summary.frames);
+  const double dnn_rmse = with_dnn.eval.ate.error_m.rmse;
+  const double twin_rmse = static_twin.eval.ate.error_m.rmse;
+  const double none_rmse = without.eval.ate.error_m.rmse;
+  EXPECT_LE(dnn_rmse, 1.5 * twin_rmse) << "dnn " << dnn_rmse << " twin " << twin_rmse;
+  EXPECT_GE(none_rmse, 3.0 * dnn_rmse) << "none " << none_rmse << " dnn " << dnn_rmse;
+  int frames_with_people = 0;
+  for (const FrameReport& r : with_dnn.summary.reports) frames_with_people += r.dynamic_instances > 0;
+  EXPECT_GT(frames_with_people, 150) << "the detector found people in too few frames";
+  std::printf("dnn %.2f mm, static twin %.2f mm (ratio %.2f), no filter %.2f mm, people in %d of %d "
+              "frames\n", 1000 * dnn_rmse, 1000 * twin_rmse, dnn_rmse / twin_rmse,
+              1000 * none_rmse, frames_with_people, static_cast<int>(with_dnn.summary.frames));
 }
 
 // A segmenter that fails from frame `fail_at` on (as a model file that cannot be read would; "from

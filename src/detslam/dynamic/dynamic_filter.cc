@@ -192,8 +192,14 @@ DepthInterval ObjectDepthInterval(const cv::Mat& depth_m, const cv::Mat& mask, c
       if (mask_row == nullptr || mask_row[x] != 0) object.push_back(d);
     }
   }
-  const DepthRange mode = DominantDepthMode(object, options.depth_bin_m, options.mode_window_m,
-                                            options.mode_min_bin_fraction);
+  DepthRange mode;
+  if (options.dominant_mode) {
+    mode = DominantDepthMode(object, options.depth_bin_m, options.mode_window_m,
+                             options.mode_min_bin_fraction);
+  } else if (!object.empty()) {
+    const auto [lo, hi] = std::minmax_element(object.begin(), object.end());
+    mode = DepthRange{true, *lo, *hi};
+  }
   if (!mode.valid) return out;
   out.m_obj = mode.min;
   out.M_obj = mode.max;

@@ -40,6 +40,10 @@ struct DynamicFilterOptions {
   double depth_bin_m = 0.05;   // histogram bin for the dominant depth mode of the object
   double mode_window_m = 0.5;  // the object's depth extent kept around its dominant mode (+-)
   double mode_min_bin_fraction = 0.02;  // bins below this fraction of the mode's count end the mode
+  // m_obj/M_obj from the dominant depth mode (true) or, as the paper writes it, the raw min/max
+  // over every mask pixel with depth (false; mask pixels on the background then widen the
+  // interval to the background's depth).
+  bool dominant_mode = true;
 
   bool Check(std::string* error) const;
   bool IsDynamicClass(const std::string& class_name) const;
@@ -64,8 +68,8 @@ DepthRange DominantDepthMode(const std::vector<float>& depths, double bin_m, dou
 
 // The depth interval of one instance.
 struct DepthInterval {
-  double m_obj = 0.0;  // min depth of the object's mask pixels (dominant mode)
-  double M_obj = 0.0;  // max depth of the object's mask pixels (dominant mode)
+  double m_obj = 0.0;  // min depth of the object's mask pixels (dominant mode, or all of them)
+  double M_obj = 0.0;  // max depth of the object's mask pixels (dominant mode, or all of them)
   double d_roi = 0.0;  // max - min valid depth over the whole box
   double lo = 0.0;     // m_obj - alpha * d_roi
   double hi = 0.0;     // M_obj + alpha * d_roi

@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include <cmath>
 #include <opencv2/imgproc.hpp>
 
@@ -126,6 +128,27 @@ TEST(ObjectDepthIntervalTest, DominantModeIgnoresLeakedWallPixels) {
   EXPECT_NEAR(interval.d_roi, 4.0 - 1.9, 1e-5);  // the box holds the wall and the person
   EXPECT_NEAR(interval.lo, 1.9 - 0.1 * 2.1, 1e-5);
   EXPECT_NEAR(interval.hi, 2.1 + 0.1 * 2.1, 1e-5);
+}
+
+TEST(ObjectDepthIntervalTest, RawMinMaxTakesTheLeakedWallPixelsAsThePaperWritesIt) {
+  const PersonScene scene;
+  DynamicFilterOptions options;
+  options.dominant_mode = false;
+  const DepthInterval interval = ObjectDepthInterval(scene.depth, scene.mask, scene.box, options);
+  ASSERT_TRUE(interval.valid);
+  double lo = 1e9, hi = -1e9;  // every mask pixel with depth, wall included
+  for (int y = scene.box.y; y < scene.box.y + scene.box.height; ++y) {
+    for (int x = scene.box.x; x < scene.box.x + scene.box.width; ++x) {
+      const float d = scene.depth.at<float>(y, x);
+      if (scene.mask.at<uint8_t>(y, x) == 0 || !(d > 0)) continue;
+      lo = std::min<double>(lo, d);
+      hi = std::max<double>(hi, d);
+    }
+  }
+  EXPECT_NEAR(interval.m_obj, lo, 1e-6);
+  EXPECT_NEAR(interval.M_obj, hi, 1e-6);
+  EXPECT_GT(interval.M_obj, 3.0);  // the leaked wall pixels reach the wall's depth
+  EXPECT_NEAR(interval.hi, hi + 0.1 * interval.d_roi, 1e-6);
 }
 
 // A 10x10 image at 3.55 m with one pixel at 1.55 m; the object's three mask pixels at 2.05, 2.15

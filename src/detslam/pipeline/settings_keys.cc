@@ -114,6 +114,7 @@ std::vector<Binding> MakeBindings() {
   k.push_back(Key("Dynamic.DepthStep", "the paper's depth-ROI step (off: mask step only)", [](auto& r) -> auto& { return r.run.slam.dynamic.filter.depth_step; }));
   k.push_back(Key("Dynamic.MaskDilation", 0, kInf, "dilate dynamic masks by this many pixels", [](auto& r) -> auto& { return r.run.slam.dynamic.filter.mask_dilation_px; }));
   k.push_back(Key("Dynamic.MinScore", 0, 1, "ignore instances scored below this", [](auto& r) -> auto& { return r.run.slam.dynamic.filter.min_score; }));
+  k.push_back(Key("Dynamic.DominantDepth", "depth step: the object's depth from its dominant depth mode (off: the paper's raw min/max over the mask pixels)", [](auto& r) -> auto& { return r.run.slam.dynamic.filter.dominant_mode; }));
   k.push_back(Key("Dynamic.PreMask", "drop dynamic corners before the ORB spatial distribution", [](auto& r) -> auto& { return r.run.slam.dynamic.premask; }));
   k.push_back(Key("Dynamic.MemoryFrames", 0, kInf, "carry lost dynamic instances forward this many frames", [](auto& r) -> auto& { return r.run.slam.dynamic.memory_frames; }));
   k.push_back(Key("Dynamic.GeometricCheck", "reject movers the segmenter missed by their residual against the tracked pose", [](auto& r) -> auto& { return r.run.slam.dynamic.geometric.enabled; }));
