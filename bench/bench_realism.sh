@@ -20,7 +20,7 @@ settings_line="bench/bench_realism.sh (PRESET=$preset TUNE_SEEDS=\"$seeds\" FRAM
 source "$here/bench_lib.sh"  # shellcheck source=bench/bench_lib.sh
 work="$(mktemp -d)"
 trap 'rm -rf "$work"' EXIT
-export bin preset frames work
+export bin preset frames work here
 
 # job CONFIG SEED: one static-twin sequence and its run; writes $work/res/CONFIG_SEED (ATE mm).
 job() {
@@ -37,6 +37,7 @@ job() {
     { cat "$d.log" >&2; return 1; }
   "$bin" eval --gt "$d/groundtruth.txt" --est "$d.run/trajectory.txt" --frames "$d" \
     --json "$d.run/eval.json" >/dev/null
+  python3 "$here/cross_check_eval.py" "$d.run/eval.json" || return 1
   mkdir -p "$work/res"
   python3 - "$d.run" >"$work/res/${config}_$seed" <<'PY'
 import json, sys
