@@ -25,8 +25,13 @@ std::optional<CarriedInstances> MaskCarrier::Carry(int64_t index, const cv::Mat&
   std::optional<Published> fresh;
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    // Newer instances than the propagator's, segmented on this frame or an earlier one.
-    if (newest_ && newest_->index > source_ && newest_->index <= index) fresh = newest_;
+    // Newer instances than the propagator's, segmented on this frame or an earlier one. The image
+    // is copied under the lock: the publisher releases the shared buffer under the same lock when
+    // it publishes the next one (cv::Mat's reference count is invisible to ThreadSanitizer).
+    if (newest_ && newest_->index > source_ && newest_->index <= index) {
+      fresh = Published{newest_->index, newest_->gray.clone(), newest_->instances};
+      for (Instance& in : fresh->instances) in.mask = in.mask.clone();
+    }
   }
   if (fresh) {
     propagator_.Reset(fresh->gray, fresh->instances);

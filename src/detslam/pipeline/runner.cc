@@ -521,7 +521,15 @@ RunSummary RunThreaded(const RgbdSource& dataset, const Settings& settings,
   bool waited_for_first_masks = false;
   const auto carry_masks = [&](LoadedFrame* f) {
     std::optional<LoadedFrame> replaced;
-    to_segment.PushDroppingOldest(*f, &replaced);
+    // The segmentation thread gets images of its own: cv::Mat's reference count lives in OpenCV's
+    // (uninstrumented) library, so buffers shared between threads and released last by another
+    // thread than the one that read them are reported by ThreadSanitizer (seen in the failing-
+    // stage test under load); owning copies leave nothing shared.
+    LoadedFrame for_segmentation = *f;
+    for_segmentation.images.bgr = f->images.bgr.clone();
+    for_segmentation.images.gray = f->images.gray.clone();
+    for_segmentation.images.depth_m = f->images.depth_m.clone();
+    to_segment.PushDroppingOldest(std::move(for_segmentation), &replaced);
     if (!waited_for_first_masks) {
       carrier.WaitFor(f->index);
       waited_for_first_masks = true;
