@@ -17,6 +17,8 @@ bool PinholeCamera::Check(std::string* error) const {
   if (!(th_depth > 0)) os << "ThDepth must be positive; ";
   if (!(disparity_sigma >= 0)) os << "DisparitySigma must be >= 0; ";
   if (!(fps > 0)) os << "fps must be positive; ";
+  if (!(rolling_shutter_readout >= 0) || (fps > 0 && rolling_shutter_readout > 1.0 / fps))
+    os << "RollingShutterReadout must be in [0, 1/fps] seconds; ";
   if (error != nullptr) *error = os.str();
   return os.str().empty();
 }

@@ -26,6 +26,11 @@ struct PinholeCamera {
   // which weights depth like a pixel of the image and so about 100-300 times below its accuracy.
   double disparity_sigma = 0.1;
   bool rgb_order = true;  // true if colour images are RGB (Camera.RGB: 1)
+  // Rolling shutter: seconds from the first image row's exposure to the last one's, the middle
+  // row exposed at the frame's stamp (Camera.RollingShutterReadout; 0: a global shutter, as
+  // ORB-SLAM3 assumes). Tracking then moves each keypoint to where the camera at the frame's stamp
+  // saw its point (tracking/rolling_shutter.h).
+  double rolling_shutter_readout = 0.0;
 
   bool Check(std::string* error) const;
   bool HasDistortion() const { return k1 != 0 || k2 != 0 || p1 != 0 || p2 != 0 || k3 != 0; }

@@ -239,6 +239,7 @@ Settings ReadSettings(const std::string& path) {
   c.height = r.Int("Camera.height", c.height, true);
   c.fps = r.Double("Camera.fps", c.fps);
   c.rgb_order = r.Bool("Camera.RGB", c.rgb_order);
+  c.rolling_shutter_readout = r.Double("Camera.RollingShutterReadout", c.rolling_shutter_readout);
   if (v1) {
     if (r.Has("Stereo.b")) c.bf = r.Double("Stereo.b", 0.0) * c.fx;
     c.th_depth = r.Double("Stereo.ThDepth", c.th_depth);
@@ -298,6 +299,12 @@ void WriteSettings(const std::string& path, const Settings& settings) {
       {"ORBextractor.iniThFAST", std::to_string(o.ini_th_fast)},
       {"ORBextractor.minThFAST", std::to_string(o.min_th_fast)},
   };
+  // detslam's own camera key, written only for a rolling shutter (ORB-SLAM3 ignores it).
+  if (c.rolling_shutter_readout > 0) {
+    const auto rgb = std::find_if(lines.begin(), lines.end(),
+                                  [](const auto& kv) { return kv.first == "Camera.RGB"; });
+    lines.insert(rgb + 1, {"Camera.RollingShutterReadout", FormatReal(c.rolling_shutter_readout)});
+  }
   std::set<std::string> written;
   for (const auto& kv : lines) written.insert(kv.first);
   WriteFileAtomically(path, [&](std::ostream& out) {

@@ -197,6 +197,12 @@ TEST_F(SettingsTest, CameraAndOrbChecksAreReportedWithTheFile) {
   EXPECT_THAT(error, HasSubstr("DepthMapFactor must be positive"));
   text = std::string(kOldStyle) + "DisparitySigma: -0.1\n";
   EXPECT_THAT(ReadError(Write("disparity.yaml", text)), HasSubstr("DisparitySigma must be >= 0"));
+  for (const char* readout : {"-0.01", "0.05"}) {  // negative; longer than a frame at 30 fps
+    text = std::string(kOldStyle) + "Camera.RollingShutterReadout: " + readout + "\n";
+    EXPECT_THAT(ReadError(Write("readout.yaml", text)),
+                HasSubstr("RollingShutterReadout must be in [0, 1/fps]"))
+        << readout;
+  }
   text = kOldStyle;
   text.replace(text.find("ORBextractor.scaleFactor: 1.25"), 30, "ORBextractor.scaleFactor: 0.9");
   EXPECT_THAT(ReadError(Write("orb.yaml", text)), HasSubstr("scaleFactor"));
@@ -271,6 +277,7 @@ TEST_F(SettingsTest, WriteReadRoundTripIsOpenCvReadable) {
   EXPECT_DOUBLE_EQ(back.camera.depth_map_factor, 5208.0);
   EXPECT_DOUBLE_EQ(back.camera.th_depth, s.camera.th_depth);
   EXPECT_DOUBLE_EQ(back.camera.disparity_sigma, 0.0);
+  EXPECT_DOUBLE_EQ(back.camera.rolling_shutter_readout, 0.0);  // a global shutter: not written
   EXPECT_EQ(back.camera.width, s.camera.width);
   EXPECT_EQ(back.orb.n_features, 1234);
   EXPECT_DOUBLE_EQ(back.orb.scale_factor, s.orb.scale_factor);
@@ -291,6 +298,12 @@ TEST_F(SettingsTest, WriteReadRoundTripIsOpenCvReadable) {
   EXPECT_TRUE(fs["Camera.fps"].isInt());
   EXPECT_TRUE(fs["ORBextractor.nFeatures"].isInt());
   EXPECT_TRUE(fs["ORBextractor.scaleFactor"].isReal());
+  EXPECT_TRUE(fs["Camera.RollingShutterReadout"].empty());
+
+  // A rolling shutter's readout time survives the round trip.
+  s.camera.rolling_shutter_readout = 0.025;
+  WriteSettings(path, s);
+  EXPECT_DOUBLE_EQ(ReadSettings(path).camera.rolling_shutter_readout, 0.025);
 }
 
 }  // namespace

@@ -102,6 +102,9 @@ SyntheticSequence::SyntheticSequence(const SynthOptions& options)
     kinect_.hole_fraction = 1e-12;
     kinect_.speckle_dropout = 0;
   }
+  // The sequence's camera calibration (settings.yaml) states its rolling shutter.
+  if (options_.realism == SynthRealism::kRealistic && options_.sensor_noise)
+    camera_.rolling_shutter_readout = colour_camera_.readout_s;
 }
 
 Timestamp SyntheticSequence::StampOf(int k) const {

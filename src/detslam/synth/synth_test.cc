@@ -81,9 +81,16 @@ TEST(SynthOptionsTest, RealismAndItsAblationsParseOrNameTheBadValue) {
   o.preset = "walking_xyz";
   o.realism_off.clear();
   const SynthFrame full = SyntheticSequence(o).Render(25);
+  // The sequence's camera states its rolling shutter (settings.yaml), none where it is off.
+  EXPECT_DOUBLE_EQ(SyntheticSequence(o).camera().rolling_shutter_readout,
+                   synth::ColourCameraModel{}.readout_s);
+  EXPECT_DOUBLE_EQ(SyntheticSequence(Opts("static")).camera().rolling_shutter_readout, 0.0);
   for (const std::string& effect : SynthRealismEffects()) {
     SynthOptions p = o;
     p.realism_off = {effect};
+    if (effect == "shutter") {
+      EXPECT_DOUBLE_EQ(SyntheticSequence(p).camera().rolling_shutter_readout, 0.0);
+    }
     const SynthFrame f = SyntheticSequence(p).Render(25);
     const bool colour_differs = cv::norm(f.bgr, full.bgr, cv::NORM_INF) > 0;
     const bool depth_differs = cv::norm(f.depth16, full.depth16, cv::NORM_INF) > 0;

@@ -11,6 +11,7 @@
 #include "detslam/features/matcher.h"
 #include "detslam/geometry/pnp_ransac.h"
 #include "detslam/map/projection_search.h"
+#include "detslam/tracking/rolling_shutter.h"
 #include "detslam/tracking/keypoint_observation.h"
 
 namespace detslam {
@@ -104,6 +105,15 @@ TrackingResult Tracker::Track(Map& map, Frame* frame) {
     return result;
   }
 
+  // Rolling shutter: keypoints moved to the frame's stamp with the motion model's velocity; once
+  // the frame is tracked, again with its own velocity and the pose optimised once more.
+  const std::shared_ptr<const FrameFeatures> raw_features = frame->features;
+  const bool rolling_shutter =
+      state_ == TrackingState::kOk && velocity_ && camera_.rolling_shutter_readout > 0;
+  if (rolling_shutter) {
+    frame->features = CompensateRollingShutter(camera_, raw_features,
+                                               TwistPerSecond(*velocity_, velocity_seconds_));
+  }
   bool ok = false;
   if (state_ == TrackingState::kOk) {
     if (velocity_ && frame->index >= last_reloc_frame_ + 2) {
@@ -132,6 +142,14 @@ TrackingResult Tracker::Track(Map& map, Frame* frame) {
     }
   }
 
+  if (ok && rolling_shutter && last_frame_ && last_frame_->cam_from_world) {
+    const Rigid3d own = *frame->cam_from_world * last_frame_->cam_from_world->Inverse();
+    frame->features = CompensateRollingShutter(
+        camera_, raw_features, TwistPerSecond(own, AbsDiffSeconds(frame->stamp, last_frame_->stamp)));
+    const std::vector<bool> outliers = frame->outlier;
+    inliers = OptimizeFramePose(map, frame, false);
+    for (size_t i = 0; i < outliers.size(); ++i) frame->outlier[i] = frame->outlier[i] || outliers[i];
+  }
   if (ok && movers_.enabled) result.geometric_rejected = ApplyGeometricCheck(map, frame, &inliers);
   if (ok) {
     state_ = TrackingState::kOk;
@@ -140,6 +158,7 @@ TrackingResult Tracker::Track(Map& map, Frame* frame) {
     result.need_keyframe = NeedNewKeyFrame(map, *frame, inliers);
     if (last_frame_ && last_frame_->cam_from_world) {
       velocity_ = *frame->cam_from_world * last_frame_->cam_from_world->Inverse();
+      velocity_seconds_ = AbsDiffSeconds(frame->stamp, last_frame_->stamp);
     }
     frame->reference_keyframe = reference_kf_;
     last_frame_ = *frame;

@@ -164,6 +164,7 @@ class Tracker {
   std::optional<Frame> last_frame_;
   std::vector<std::optional<Eigen::Vector3d>> temporary_points_;  // per last-frame keypoint
   std::optional<Rigid3d> velocity_;  // cam_from_world(k) * world_from_cam(k-1)
+  double velocity_seconds_ = 0.0;    // stamp(k) - stamp(k-1) of velocity_
   KeyFrameId reference_kf_ = kNoKeyFrame;
   int new_map_id_ = -1;  // >= 0 while Initialize makes the first keyframe of that map
   KeyFrameId last_keyframe_ = kNoKeyFrame;
