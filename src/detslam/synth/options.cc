@@ -91,7 +91,8 @@ bool SynthOptions::Check(std::string* error) const {
 const std::vector<std::string>& SynthRealismEffects() {
   static const std::vector<std::string> kEffects = {"timing", "shutter",      "blur",
                                                     "colour", "quantisation", "noise",
-                                                    "distortion", "dropouts", "rooms"};
+                                                    "distortion", "dropouts", "rooms",
+                                                    "people"};
   return kEffects;
 }
 

@@ -14,7 +14,9 @@ namespace detslam {
 //     disparity distortion, projector shadow bands, mixed pixels at edges, no return from dark and
 //     grazing surfaces, registration borders) rendered at the depth image's own time, and a colour
 //     camera with a rolling shutter, motion blur of camera and people, lens softness,
-//     signal-dependent noise and a drifting auto-exposure (synth/realistic_sensor.h).
+//     signal-dependent noise and a drifting auto-exposure (synth/realistic_sensor.h); people
+//     that swing their legs, turn with their walking direction, come within 0.7 m of the camera
+//     and cross in front of each other (synth/people.h).
 enum class SynthRealism { kEasy, kRealistic };
 
 // The realistic mode's effects that --realism-off can switch off, in a fixed order:
@@ -28,6 +30,8 @@ enum class SynthRealism { kEasy, kRealistic };
 //   dropouts      every pixel with a surface in range has depth (no borders, shadows, edges,
 //                 grazing, dark or glass dropouts, holes)
 //   rooms         the easy mode's busy walls and no windows
+//   people        the easy mode's people: rigid sprites always facing the camera, on the easy
+//                 mode's paths (no swinging legs, no turning, no close pass or crossing)
 const std::vector<std::string>& SynthRealismEffects();
 // Parses a comma-separated --realism-off list into options->realism_off; throws InputError
 // naming an unknown effect.

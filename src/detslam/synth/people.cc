@@ -85,7 +85,44 @@ void ComputeSilhouetteRows(Sprite* sprite) {
   }
 }
 
-std::vector<PersonLook> LoadPhotoPeople(const std::string& dir) {
+Sprite SwingLegs(const Sprite& photo, double angle) {
+  const int h = photo.alpha.rows, w = photo.alpha.cols;
+  const int hip = static_cast<int>(0.6 * h);
+  float mid = photo.row_mid[hip];
+  if (mid < 0) mid = 0.5f * w;
+  Sprite out;
+  out.bgr = cv::Mat(h, w, CV_8UC3, cv::Scalar::all(0));
+  out.alpha = cv::Mat(h, w, CV_8U, cv::Scalar(0));
+  photo.bgr.rowRange(0, hip).copyTo(out.bgr.rowRange(0, hip));
+  photo.alpha.rowRange(0, hip).copyTo(out.alpha.rowRange(0, hip));
+  // Each leg: pixels of its side below the hip, rotated about its joint (a quarter of the hip
+  // width from the middle); the destination takes whichever leg covers it, the forward one first.
+  const float joint_dx = 0.5f * std::max(1.f, photo.row_half[hip]);
+  const double a[2] = {angle, -angle};  // left, right leg
+  const int order[2] = {angle >= 0 ? 0 : 1, angle >= 0 ? 1 : 0};
+  for (int y = hip; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      for (int leg : order) {
+        const float jx = leg == 0 ? mid - joint_dx : mid + joint_dx;
+        const double c = std::cos(a[leg]), s = std::sin(a[leg]);
+        // Inverse rotation of (x, y) about the joint (jx, hip).
+        const double dx = x - jx, dy = y - hip;
+        const double sx = jx + c * dx + s * dy, sy = hip - s * dx + c * dy;
+        const int ix = static_cast<int>(std::lround(sx)), iy = static_cast<int>(std::lround(sy));
+        if (ix < 0 || iy < hip || ix >= w || iy >= h) continue;
+        if ((leg == 0) != (ix < mid)) continue;  // a pixel of the other leg
+        if (photo.alpha.at<uchar>(iy, ix) <= 127) continue;
+        out.bgr.at<cv::Vec3b>(y, x) = photo.bgr.at<cv::Vec3b>(iy, ix);
+        out.alpha.at<uchar>(y, x) = 255;
+        break;
+      }
+    }
+  }
+  ComputeSilhouetteRows(&out);
+  return out;
+}
+
+std::vector<PersonLook> LoadPhotoPeople(const std::string& dir, int gait_phases) {
   namespace fs = std::filesystem;
   std::error_code ec;
   if (!fs::is_directory(dir, ec)) throw InputError(dir, 0, "people folder does not exist");
@@ -114,7 +151,11 @@ std::vector<PersonLook> LoadPhotoPeople(const std::string& dir) {
     s.bgr = s.bgr(bbox).clone();
     s.alpha = ch[3](bbox).clone();
     ComputeSilhouetteRows(&s);
-    looks.push_back(PersonLook{{std::move(s)}});
+    PersonLook look;
+    for (int p = 1; p < gait_phases; ++p)  // phase 0 is the photo, then one swing cycle
+      look.gait.push_back(SwingLegs(s, 0.3 * std::sin(2.0 * kPi * p / gait_phases)));
+    look.gait.insert(look.gait.begin(), std::move(s));
+    looks.push_back(std::move(look));
   }
   return looks;
 }
@@ -189,7 +230,8 @@ PersonLook MakeProceduralPerson(uint64_t seed, int phases) {
   return look;
 }
 
-PeopleScript::PeopleScript(const std::string& preset, uint64_t seed) {
+PeopleScript::PeopleScript(const std::string& preset, uint64_t seed, bool realistic)
+    : realistic_(realistic) {
   RequireSynthPreset(preset);
   Rng rng(seed ^ 0x9E091EULL);
   auto phase = [&] { return rng.Uniform(0.0, 2.0 * kPi); };
@@ -225,6 +267,17 @@ PeopleScript::PeopleScript(const std::string& preset, uint64_t seed) {
     walkers_.push_back({{0.0, 2.1}, {1, 0}, 1.2, 18.0, phase(), 0.08, 1.72, false});
     return;
   }
+  if (realistic) {
+    // Walking presets, realistic: one person walks diagonally from beside the table to about
+    // 1 m in front of the camera's resting place (0, -1.6) and back (0.6-0.7 m where the camera
+    // moves towards them, as in walking_xyz); the other crosses the view behind them with the
+    // same period, so that they pass in front of each other twice a cycle.
+    walkers_.push_back({{0.075, -0.204}, {0.45, -0.89}, 0.5, 12.0, phase(), 0.08, 1.74, false});
+    walkers_.push_back({{0.1, 0.35}, {-1, 0.1}, 1.3, 12.0, walkers_[0].phase + 0.5 * kPi, 0.10,
+                        1.68, false});
+    for (auto& w : walkers_) w.axis.normalize();
+    return;
+  }
   // Walking presets: two people crossing the view back and forth in front of the table
   // (1.3-2.2 m from the camera), at up to ~1 m/s, leaving and re-entering the view.
   walkers_.push_back({{0.0, -0.25}, {1, 0.08}, 1.2, 11.0, phase(), 0.12, 1.74, false});
@@ -256,6 +309,14 @@ std::vector<PersonState> PeopleScript::At(double t) const {
       bob = 0.01 * std::sin(1.7 * arg);
     }
     s.foot = Eigen::Vector3d(xy.x(), xy.y(), bob);
+    if (realistic_ && !w.sitting) {
+      // Facing the walking direction, turning round at each end of the walk within about a
+      // tenth of the period: yaw from the axis (forward) to the axis + pi (back), through the
+      // side in between.
+      const double forward = std::tanh(4.0 * std::cos(arg));  // +1 walking along the axis
+      s.has_facing = true;
+      s.facing_yaw = std::atan2(w.axis.y(), w.axis.x()) + 0.5 * kPi * (1.0 - forward);
+    }
     out.push_back(s);
   }
   return out;

@@ -25,9 +25,15 @@ struct PersonLook {
 };
 
 // Loads every *.png in `dir` (sorted by name) as an RGBA photo cut-out cropped to its silhouette.
-// Throws InputError naming the folder if it is missing or has no PNG, or naming the file if a PNG
-// cannot be read or has no alpha channel.
-std::vector<PersonLook> LoadPhotoPeople(const std::string& dir);
+// With `gait_phases` > 1 each photo gets that many gait sprites (SwingLegs). Throws InputError
+// naming the folder if it is missing or has no PNG, or naming the file if a PNG cannot be read or
+// has no alpha channel.
+std::vector<PersonLook> LoadPhotoPeople(const std::string& dir, int gait_phases = 1);
+
+// A gait sprite from a photo cut-out: the part below the hips (the lowest 40 % of the silhouette)
+// is split at its middle column into two legs that swing about their hip joints by +-`angle`
+// radians (positive: the left leg forward), the body above stays.
+Sprite SwingLegs(const Sprite& photo, double angle);
 
 // A procedural walker (head, hair, torso with clothing texture, swinging arms and legs) with
 // `phases` gait sprites; colours and clothing are drawn from `seed`.
@@ -44,12 +50,19 @@ struct PersonState {
   double depth_bulge = 0.14;  // how far the body centre stands out of the billboard (metres)
   int look = 0;               // index into the looks
   int gait_phase = 0;         // index into PersonLook::gait (modulo its size)
+  // Realistic people turn with their walking direction: the body's facing (world yaw, radians)
+  // narrows the sprite seen from the side and mirrors it seen from behind (renderer). Without a
+  // facing the sprite faces the camera at full width.
+  bool has_facing = false;
+  double facing_yaw = 0.0;
 };
 
 // The scripted people of a preset: positions at time t (seconds). Empty for "static".
 class PeopleScript {
  public:
-  PeopleScript(const std::string& preset, uint64_t seed);
+  // `realistic`: people turn with their walking direction, and in the walking presets one of them
+  // walks up to 0.7 m from the camera and the two cross in front of each other.
+  PeopleScript(const std::string& preset, uint64_t seed, bool realistic = false);
   std::vector<PersonState> At(double t) const;
   int count() const { return static_cast<int>(walkers_.size()); }
 
@@ -65,6 +78,7 @@ class PeopleScript {
     bool sitting;            // small motions only, no gait
   };
   std::vector<Walker> walkers_;
+  bool realistic_ = false;
 };
 
 }  // namespace detslam::synth

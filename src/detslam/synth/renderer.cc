@@ -73,6 +73,7 @@ struct Billboard {
   const Sprite* sprite = nullptr;
   Vec3 foot, normal, right, up{0.f, 0.f, 1.f};
   float width = 0, height = 0, bulge = 0;
+  bool mirrored = false;  // seen from behind: the sprite mirrored
   PixelRect rect;
 };
 
@@ -135,6 +136,14 @@ void RenderIdealRows(const Scene& scene, const std::vector<PersonLook>& looks,
     bb.right = bb.up.cross(bb.normal);
     bb.height = static_cast<float>(p.height);
     bb.width = bb.height * bb.sprite->bgr.cols / static_cast<float>(bb.sprite->bgr.rows);
+    if (p.has_facing) {
+      // A body about 0.55 times as deep as it is wide, seen at angle beta from its front.
+      const Vec3 facing(static_cast<float>(std::cos(p.facing_yaw)),
+                        static_cast<float>(std::sin(p.facing_yaw)), 0.f);
+      const float cb = facing.dot(bb.normal), sb = std::sqrt(std::max(0.f, 1.f - cb * cb));
+      bb.width *= std::min(1.f, std::abs(cb) + 0.55f * sb);
+      bb.mirrored = cb < 0.f;
+    }
     bb.bulge = static_cast<float>(p.depth_bulge);
     std::vector<Vec3> corners;
     for (float s : {-0.5f, 0.5f}) {
@@ -221,7 +230,8 @@ void RenderIdealRows(const Scene& scene, const std::vector<PersonLook>& looks,
             if (t_plane <= 0.f || t_plane - bb.bulge / denom >= best_t + 0.3f) continue;
             const Vec3 q = c + t_plane * d - bb.foot;
             const Sprite& sp = *bb.sprite;
-            const float scol = (q.dot(bb.right) / bb.width + 0.5f) * sp.bgr.cols;
+            const float across = q.dot(bb.right) / bb.width + 0.5f;
+            const float scol = (bb.mirrored ? 1.f - across : across) * sp.bgr.cols;
             const float srow = (1.f - q.dot(bb.up) / bb.height) * sp.bgr.rows;
             const int ic = static_cast<int>(std::floor(scol)), ir = static_cast<int>(std::floor(srow));
             if (ic < 0 || ir < 0 || ic >= sp.bgr.cols || ir >= sp.bgr.rows) continue;

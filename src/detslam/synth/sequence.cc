@@ -68,6 +68,13 @@ double SynthFrame::Coverage() const {
   return static_cast<double>(cv::countNonZero(instance_mask)) / instance_mask.total();
 }
 
+namespace {
+bool RealisticPeople(const SynthOptions& options) {
+  return options.realism == SynthRealism::kRealistic && options.sensor_noise &&
+         !options.RealismOff("people");
+}
+}  // namespace
+
 SyntheticSequence::SyntheticSequence(const SynthOptions& options)
     : options_(Validated(options)),
       frames_(SynthFrameCount(options)),
@@ -75,9 +82,10 @@ SyntheticSequence::SyntheticSequence(const SynthOptions& options)
       scene_(synth::BuildSceneForPreset(options.preset, options.SceneSeed(),
                                         SynthTextureStyle(options))),
       path_(options.preset, options.seed),
-      people_(options.preset, options.seed) {
+      people_(options.preset, options.seed, RealisticPeople(options)) {
   if (!options_.people_dir.empty()) {
-    looks_ = synth::LoadPhotoPeople(options_.people_dir);
+    // Realistic people swing their legs (8 gait sprites per photo).
+    looks_ = synth::LoadPhotoPeople(options_.people_dir, RealisticPeople(options) ? 8 : 1);
   } else {
     for (int i = 0; i < std::max(1, people_.count()); ++i) {
       looks_.push_back(synth::MakeProceduralPerson(options_.seed * 131 + static_cast<uint64_t>(i)));

@@ -44,6 +44,25 @@ TEST(DataSynthPeopleTest, PhotoCutOutsTextureThePeople) {
   }
   EXPECT_GT(coverage / ((photo.size() + 39) / 40), 0.05);
   EXPECT_GT(differing_frames, 3);
+  // The realistic mode's photo people swing their legs: 8 gait sprites, the photo first, the
+  // others differing from it below the hips only.
+  const auto walking = synth::LoadPhotoPeople(dir, 8);
+  ASSERT_EQ(walking.size(), looks.size());
+  for (size_t i = 0; i < walking.size(); ++i) {
+    ASSERT_EQ(walking[i].gait.size(), 8u);
+    const cv::Mat& photo_alpha = looks[i].gait[0].alpha;
+    EXPECT_EQ(cv::norm(walking[i].gait[0].alpha, photo_alpha, cv::NORM_INF), 0.0);
+    const int hip = static_cast<int>(0.6 * photo_alpha.rows);
+    for (int p = 1; p < 8; ++p) {
+      const cv::Mat& a = walking[i].gait[p].alpha;
+      EXPECT_EQ(cv::norm(a.rowRange(0, hip), photo_alpha.rowRange(0, hip), cv::NORM_INF), 0.0);
+      if (p != 4) {  // phase 4: sin(pi) = 0, no swing
+        EXPECT_GT(cv::countNonZero(a.rowRange(hip, a.rows) != photo_alpha.rowRange(hip, a.rows)),
+                  100)
+            << "look " << i << " phase " << p;
+      }
+    }
+  }
 }
 
 }  // namespace
