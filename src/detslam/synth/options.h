@@ -16,7 +16,8 @@ namespace detslam {
 //     camera with a rolling shutter, motion blur of camera and people, lens softness,
 //     signal-dependent noise and a drifting auto-exposure (synth/realistic_sensor.h); people
 //     that swing their legs, turn with their walking direction, come within 0.7 m of the camera
-//     and cross in front of each other (synth/people.h).
+//     and cross in front of each other (synth/people.h), and in sitting_static a laptop on the
+//     desk that a sitting person pushes aside and back (class "laptop" in the masks).
 enum class SynthRealism { kEasy, kRealistic };
 
 // The realistic mode's effects that --realism-off can switch off, in a fixed order:
@@ -31,7 +32,8 @@ enum class SynthRealism { kEasy, kRealistic };
 //                 grazing, dark or glass dropouts, holes)
 //   rooms         the easy mode's busy walls and no windows
 //   people        the easy mode's people: rigid sprites always facing the camera, on the easy
-//                 mode's paths (no swinging legs, no turning, no close pass or crossing)
+//                 mode's paths (no swinging legs, no turning, no close pass or crossing, no
+//                 laptop moved in sitting_static)
 const std::vector<std::string>& SynthRealismEffects();
 // Parses a comma-separated --realism-off list into options->realism_off; throws InputError
 // naming an unknown effect.

@@ -137,5 +137,49 @@ TEST(SynthPeopleTest, SideOnPeopleAreNarrowerAndFromBehindMirrored) {
   EXPECT_LT(cv::countNonZero(flipped != front), cv::countNonZero(front) / 20);
 }
 
+TEST(SynthPeopleTest, RealisticSittingPresetMovesALaptopButNotInTheTwin) {
+  SynthOptions o;
+  o.preset = "sitting_static";
+  o.seed = 1;
+  o.frames = 300;
+  o.realism = SynthRealism::kRealistic;
+  SynthOptions twin_options = o;
+  twin_options.people = false;
+  const SyntheticSequence seq(o), twin(twin_options);
+  auto laptop = [](const SynthFrame& f) -> const SynthInstance* {
+    for (const SynthInstance& in : f.instances)
+      if (in.label == "laptop") return &in;
+    return nullptr;
+  };
+  // Frame 0: at rest; frame 200 (6.7 s): pushed 0.45 m to the left (the push starts at 2.5-5 s
+  // and takes 1.5 s), about 80 pixels at 1.7 m.
+  const SynthFrame a = seq.Render(0), b = seq.Render(200);
+  ASSERT_NE(laptop(a), nullptr);
+  ASSERT_NE(laptop(b), nullptr);
+  EXPECT_GT(laptop(a)->pixels, 3000);
+  EXPECT_LT(laptop(b)->box.x, laptop(a)->box.x - 60);
+  EXPECT_NEAR(laptop(b)->box.y, laptop(a)->box.y, 12);
+  // The twin has the laptop at rest and no instances.
+  const SynthFrame ta = twin.Render(0), tb = twin.Render(200);
+  EXPECT_TRUE(ta.instances.empty());
+  EXPECT_TRUE(tb.instances.empty());
+  // The median true depth over the laptop's resting place: unchanged in the twin (the camera
+  // moves by millimetres), much farther once the laptop has gone in the sequence.
+  const cv::Rect rest = laptop(a)->box;
+  auto median = [&](const SynthFrame& f) {
+    const cv::Mat roi = f.true_depth(rest).clone();
+    std::vector<float> z(roi.begin<float>(), roi.end<float>());
+    std::nth_element(z.begin(), z.begin() + z.size() / 2, z.end());
+    return z[z.size() / 2];
+  };
+  EXPECT_NEAR(median(ta), median(tb), 0.02);
+  EXPECT_NEAR(median(a), median(ta), 0.02);
+  EXPECT_GT(median(b), median(a) + 0.2);
+  // The easy mode has no laptop.
+  SynthOptions easy = o;
+  easy.realism = SynthRealism::kEasy;
+  EXPECT_EQ(laptop(SyntheticSequence(easy).Render(200)), nullptr);
+}
+
 }  // namespace
 }  // namespace detslam

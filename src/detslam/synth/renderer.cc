@@ -207,6 +207,7 @@ void RenderIdealRows(const Scene& scene, const std::vector<PersonLook>& looks,
           uint16_t id = 0;
           if (best_box >= 0) {
             const SceneBox& b = scene.boxes[best_box];
+            id = b.instance;
             const Vec3 p = c + best_t * d;
             float col, row;
             FaceTexel(b, best_axis, p, &col, &row);

@@ -18,7 +18,7 @@ namespace detslam::synth {
 struct IdealFrame {
   cv::Mat bgr;    // CV_8UC3 colour
   cv::Mat depth;  // CV_32F depth along the optical axis (metres), 0 where nothing was hit
-  cv::Mat ids;    // CV_16U instance id: 0 static scene, k for person k
+  cv::Mat ids;    // CV_16U instance id: 0 static scene, k for person k (or a box's instance)
   // CV_8U infrared return: the unshaded texel's grey level x the surface's InfraredGain (the
   // projector lights every surface alike; what comes back depends on the material), 0 where
   // nothing was hit. Only RenderIdealRows fills it when it is allocated.

@@ -24,6 +24,7 @@ struct SceneBox {
   Eigen::Vector3f hi;            // maximum corner (metres, world)
   bool interior = false;         // true for the room shell, which is seen from inside
   std::array<int, 6> texture{};  // index into Scene::textures for each face (FaceIndex)
+  uint16_t instance = 0;         // id of its pixels in the instance mask (0: the static scene)
 };
 
 struct Scene {

@@ -113,6 +113,56 @@ SyntheticSequence::SyntheticSequence(const SynthOptions& options)
   // The sequence's camera calibration (settings.yaml) states its rolling shutter.
   if (options_.realism == SynthRealism::kRealistic && options_.sensor_noise)
     camera_.rolling_shutter_readout = colour_camera_.readout_s;
+  if (options_.preset == "sitting_static" && RealisticPeople(options_)) {
+    // A closed-lid laptop on the desk in front of the person on the right (its back to the
+    // camera); in the twin it stays where it is.
+    Rng rng(options_.SceneSeed() ^ 0x1A9709ULL);
+    moved_instance_ = static_cast<uint16_t>(std::max(1, people_.count()) + 1);
+    auto add = [&](const Eigen::Vector3f& lo, const Eigen::Vector3f& hi, synth::SurfaceKind kind) {
+      synth::SceneBox b;
+      b.lo = lo;
+      b.hi = hi;
+      b.instance = options_.people ? moved_instance_ : 0;  // the twin's laptop never moves
+      for (int axis = 0; axis < 3; ++axis) {
+        const int ua = axis == 0 ? 1 : 0, va = axis == 2 ? 1 : 2;
+        const int w = static_cast<int>(std::ceil((hi[ua] - lo[ua]) * synth::kTexelsPerMetre)) + 2;
+        const int h = static_cast<int>(std::ceil((hi[va] - lo[va]) * synth::kTexelsPerMetre)) + 2;
+        for (bool side : {false, true}) {
+          Rng face_rng = rng.Fork(scene_.textures.size() + 1);
+          b.texture[synth::FaceIndex(axis, side)] = static_cast<int>(scene_.textures.size());
+          scene_.textures.push_back(synth::MakeSurfaceTexture(kind, w, h, face_rng));
+          scene_.ir_gain.push_back(synth::InfraredGain(kind));
+        }
+      }
+      moved_boxes_.push_back(static_cast<int>(scene_.boxes.size()));
+      scene_.boxes.push_back(b);
+    };
+    add({0.32f, 1.40f, 0.755f}, {0.68f, 1.64f, 0.78f}, synth::SurfaceKind::kMetal);   // base
+    add({0.32f, 1.64f, 0.78f}, {0.68f, 1.665f, 1.02f}, synth::SurfaceKind::kPoster);  // lid
+    moved_at_ = rng.Uniform(2.5, 5.0);
+  }
+}
+
+Eigen::Vector3f SyntheticSequence::MovedObjectOffset(double t) const {
+  if (moved_boxes_.empty() || !options_.people) return Eigen::Vector3f::Zero();
+  // Pushed 0.45 m to the left over 1.5 s (smooth start and stop), back 5 s later.
+  auto ease = [](double x) {
+    x = std::clamp(x, 0.0, 1.0);
+    return x * x * (3.0 - 2.0 * x);
+  };
+  const double out = ease((t - moved_at_) / 1.5) - ease((t - moved_at_ - 5.0) / 1.5);
+  return Eigen::Vector3f(static_cast<float>(-0.45 * out), 0.f, 0.f);
+}
+
+const synth::Scene& SyntheticSequence::SceneAt(double t, synth::Scene* storage) const {
+  const Eigen::Vector3f offset = MovedObjectOffset(t);
+  if (offset.isZero()) return scene_;
+  *storage = scene_;  // textures are shared (cv::Mat headers)
+  for (int i : moved_boxes_) {
+    storage->boxes[i].lo += offset;
+    storage->boxes[i].hi += offset;
+  }
+  return *storage;
 }
 
 Timestamp SyntheticSequence::StampOf(int k) const {
@@ -144,8 +194,9 @@ synth::IdealFrame SyntheticSequence::RenderRollingShutter(double t) const {
     const int v0 = b * h / bands, v1 = (b + 1) * h / bands;
     // The middle row is exposed at the frame's stamp (its ground-truth pose).
     const double tb = t + ((v0 + v1) * 0.5 - h * 0.5) / h * colour_camera_.readout_s;
-    synth::RenderIdealRows(scene_, looks_, people_at(tb), camera_, path_.WorldFromCam(tb), v0, v1,
-                           &out);
+    synth::Scene moved;
+    synth::RenderIdealRows(SceneAt(tb, &moved), looks_, people_at(tb), camera_,
+                           path_.WorldFromCam(tb), v0, v1, &out);
   }
   // Motion blur: the camera's image motion at the median depth for the static scene, and each
   // person's own image motion (body centre) over the person's pixels.
@@ -244,8 +295,10 @@ SynthFrame SyntheticSequence::RenderRealistic(SynthFrame f) const {
   f.instance_mask = colour.ids;
   // The depth camera's own exposure, at the depth image's stamp.
   const double td = options_.RealismOff("timing") ? t : SecondsOf(f.depth_stamp);
+  synth::Scene moved;
   synth::IdealFrame ideal =
-      synth::RenderIdeal(scene_, looks_, options_.people ? people_.At(td) : std::vector<synth::PersonState>{},
+      synth::RenderIdeal(SceneAt(td, &moved), looks_,
+                         options_.people ? people_.At(td) : std::vector<synth::PersonState>{},
                          camera_, path_.WorldFromCam(td));
   if (options_.Covered(k)) {
     f.bgr.setTo(cv::Scalar::all(0));
@@ -265,7 +318,7 @@ SynthFrame SyntheticSequence::RenderRealistic(SynthFrame f) const {
   return f;
 }
 
-void SyntheticSequence::FillInstances(SynthFrame* frame) {
+void SyntheticSequence::FillInstances(SynthFrame* frame) const {
   SynthFrame& f = *frame;
   // Instances: bounding boxes of the visible mask pixels.
   std::map<int, SynthInstance> found;
@@ -283,7 +336,10 @@ void SyntheticSequence::FillInstances(SynthFrame* frame) {
       ++in.pixels;
     }
   }
-  for (auto& [id, in] : found) f.instances.push_back(in);
+  for (auto& [id, in] : found) {
+    if (moved_instance_ != 0 && id == moved_instance_) in.label = "laptop";
+    f.instances.push_back(in);
+  }
 }
 
 }  // namespace detslam

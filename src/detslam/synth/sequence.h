@@ -85,8 +85,12 @@ class SyntheticSequence {
   synth::IdealFrame RenderRollingShutter(double t) const;
   // Render's realistic sensor path for frame f.index (stamps and pose already set).
   SynthFrame RenderRealistic(SynthFrame f) const;
-  // Instances (boxes, pixel counts) from f's instance mask.
-  static void FillInstances(SynthFrame* f);
+  // Instances (boxes, pixel counts, labels) from f's instance mask.
+  void FillInstances(SynthFrame* f) const;
+  // The world at time t: the scene with the moved object (if any) where it is then.
+  const synth::Scene& SceneAt(double t, synth::Scene* storage) const;
+  // Where the moved object is at time t, relative to its resting place (metres, world).
+  Eigen::Vector3f MovedObjectOffset(double t) const;
   // Seconds from the first frame of a stamp.
   static double SecondsOf(Timestamp stamp) { return (stamp.ns - kEpochNs) * 1e-9; }
 
@@ -100,6 +104,11 @@ class SyntheticSequence {
   synth::SensorModel sensor_;
   synth::KinectDepthModel kinect_;
   synth::ColourCameraModel colour_camera_;
+  // The realistic sitting preset's laptop on the desk, which a sitting person pushes aside and
+  // back (boxes of scene_ with instance moved_instance_, label "laptop"); none elsewhere.
+  std::vector<int> moved_boxes_;
+  uint16_t moved_instance_ = 0;
+  double moved_at_ = 0.0;  // seconds: the push starts (the way back 5 s later)
 };
 
 }  // namespace detslam
