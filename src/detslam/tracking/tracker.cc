@@ -44,6 +44,7 @@ const char* ToString(TrackingState state) {
 bool TrackerOptions::Check(std::string* error) const {
   std::ostringstream os;
   if (min_init_keypoints < 1) os << "min_init_keypoints must be >= 1; ";
+  if (min_init_depth_keypoints < 3) os << "min_init_depth_keypoints must be >= 3; ";
   if (!(motion_window > 0) || !(local_map_window > 0)) os << "search windows must be positive; ";
   if (min_pose_inliers < 3) os << "min_pose_inliers must be >= 3; ";
   if (max_frames_between_keyframes < 1) os << "max_frames_between_keyframes must be >= 1; ";
@@ -98,7 +99,7 @@ TrackingResult Tracker::Track(Map& map, Frame* frame) {
       result.pose_valid = true;
       result.method = "init";
     } else {
-      result.method = "waiting for a frame with enough depth";
+      result.method = "waiting for a frame with enough keypoints and depth";
     }
     result.state = state_;
     if (result.pose_valid) last_frame_ = *frame, BuildTemporaryPoints(map);
@@ -195,7 +196,9 @@ bool Tracker::Initialize(Map& map, Frame* frame) {
   const FrameFeatures& f = *frame->features;
   int with_depth = 0;
   for (size_t i = 0; i < f.size(); ++i) with_depth += f.depth[i] > 0 ? 1 : 0;
-  if (with_depth < options_.min_init_keypoints) return false;
+  if (static_cast<int>(f.size()) <= options_.min_init_keypoints ||
+      with_depth < options_.min_init_depth_keypoints)
+    return false;
   PrepareFrame(frame);
   frame->cam_from_world = Rigid3d::Identity();
   new_map_id_ = map.NewMapId();

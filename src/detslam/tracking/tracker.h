@@ -21,7 +21,9 @@ enum class TrackingState { kNotInitialized, kOk, kRecentlyLost, kLost };
 const char* ToString(TrackingState state);
 
 struct TrackerOptions {
-  int min_init_keypoints = 500;    // keypoints with depth needed to initialise
+  int min_init_keypoints = 500;    // initialise from a frame with more keypoints than this
+                                   // (ORB-SLAM3's N > 500, counted after the dynamic filter)
+  int min_init_depth_keypoints = 100;  // ... of which at least this many have depth (the map)
   double motion_window = 7.0;      // projection window, motion model (RGB-D: 7 px at level 0)
   double local_map_window = 3.0;   // projection window for local map points
   int min_motion_matches = 20;     // else retry with twice the window
