@@ -6,6 +6,7 @@
 #include <Eigen/Core>
 #include <array>
 #include <cstdint>
+#include <utility>
 
 #include "detslam/core/rng.h"
 #include "detslam/synth/scene.h"
@@ -17,6 +18,9 @@ class SceneBuilder {
  public:
   explicit SceneBuilder(uint64_t seed, const TextureStyle& style = {})
       : rng_(seed), style_(style) {}
+  // Goes on building `existing` (its boxes and textures kept), with textures seeded from `seed`.
+  SceneBuilder(uint64_t seed, Scene existing, const TextureStyle& style = {})
+      : rng_(seed), style_(style), scene_(std::move(existing)) {}
 
   // Adds a box whose faces use `sides` texture, the top (+z) face `top`; `special_face` (if >= 0)
   // uses `special`. Returns the box's index.
@@ -40,6 +44,8 @@ class SceneBuilder {
   void Monitor(float cx, float cy, float z, bool faces_minus_y);
 
   Scene& scene() { return scene_; }
+  // The generator the textures are forked from (for further draws of the same seed).
+  Rng& rng() { return rng_; }
   Scene Take() { return std::move(scene_); }
 
  private:

@@ -9,6 +9,7 @@
 #include "detslam/core/check.h"
 #include "detslam/synth/hash_noise.h"
 #include "detslam/synth/renderer.h"
+#include "detslam/synth/scene_builder.h"
 
 namespace detslam {
 namespace {
@@ -116,30 +117,17 @@ SyntheticSequence::SyntheticSequence(const SynthOptions& options)
   if (options_.preset == "sitting_static" && RealisticPeople(options_)) {
     // A closed-lid laptop on the desk in front of the person on the right (its back to the
     // camera); in the twin it stays where it is.
-    Rng rng(options_.SceneSeed() ^ 0x1A9709ULL);
     moved_instance_ = static_cast<uint16_t>(std::max(1, people_.count()) + 1);
-    auto add = [&](const Eigen::Vector3f& lo, const Eigen::Vector3f& hi, synth::SurfaceKind kind) {
-      synth::SceneBox b;
-      b.lo = lo;
-      b.hi = hi;
-      b.instance = options_.people ? moved_instance_ : 0;  // the twin's laptop never moves
-      for (int axis = 0; axis < 3; ++axis) {
-        const int ua = axis == 0 ? 1 : 0, va = axis == 2 ? 1 : 2;
-        const int w = static_cast<int>(std::ceil((hi[ua] - lo[ua]) * synth::kTexelsPerMetre)) + 2;
-        const int h = static_cast<int>(std::ceil((hi[va] - lo[va]) * synth::kTexelsPerMetre)) + 2;
-        for (bool side : {false, true}) {
-          Rng face_rng = rng.Fork(scene_.textures.size() + 1);
-          b.texture[synth::FaceIndex(axis, side)] = static_cast<int>(scene_.textures.size());
-          scene_.textures.push_back(synth::MakeSurfaceTexture(kind, w, h, face_rng));
-          scene_.ir_gain.push_back(synth::InfraredGain(kind));
-        }
-      }
-      moved_boxes_.push_back(static_cast<int>(scene_.boxes.size()));
-      scene_.boxes.push_back(b);
-    };
-    add({0.32f, 1.40f, 0.755f}, {0.68f, 1.64f, 0.78f}, synth::SurfaceKind::kMetal);   // base
-    add({0.32f, 1.64f, 0.78f}, {0.68f, 1.665f, 1.02f}, synth::SurfaceKind::kPoster);  // lid
-    moved_at_ = rng.Uniform(2.5, 5.0);
+    synth::SceneBuilder b(options_.SceneSeed() ^ 0x1A9709ULL, std::move(scene_));
+    using synth::SurfaceKind;
+    moved_boxes_ = {b.Box({0.32f, 1.40f, 0.755f}, {0.68f, 1.64f, 0.78f}, SurfaceKind::kMetal,
+                          SurfaceKind::kMetal),  // base
+                    b.Box({0.32f, 1.64f, 0.78f}, {0.68f, 1.665f, 1.02f}, SurfaceKind::kPoster,
+                          SurfaceKind::kPoster)};  // lid
+    moved_at_ = b.rng().Uniform(2.5, 5.0);
+    scene_ = b.Take();
+    // The twin's laptop never moves: no instance there.
+    for (int i : moved_boxes_) scene_.boxes[i].instance = options_.people ? moved_instance_ : 0;
   }
 }
 
