@@ -42,32 +42,34 @@ DetSlamStage::DetSlamStage(DetSlamOptions options, Segmenter* segmenter)
   DETSLAM_CHECK_MSG(options_.Check(&error), "invalid DetSlamOptions: " << error);
 }
 
-FrameInstances DetSlamStage::Segment(const SegmenterInput& input, const cv::Mat& gray) {
+namespace {
+// Runs `segment` (returning the frame's instances) and times it.
+template <typename SegmentFn>
+FrameInstances Timed(SegmentFn&& segment) {
   FrameInstances out;
-  if (segmenter_ == nullptr) return out;
   const auto t0 = std::chrono::steady_clock::now();
-  const int every = options_.segment_every;
-  if (every > 1 && input.index % every != 0) {
-    out.instances = propagator_.Propagate(gray);
-  } else {
-    out.instances = memory_.Update(segmenter_->Segment(input));
-    if (every > 1) propagator_.Reset(gray, out.instances);
-  }
+  out.instances = segment();
   out.segmented = true;
   out.segmentation_ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   return out;
 }
+}  // namespace
+
+FrameInstances DetSlamStage::Segment(const SegmenterInput& input, const cv::Mat& gray) {
+  if (segmenter_ == nullptr) return {};
+  return Timed([&] {
+    const int every = options_.segment_every;
+    if (every > 1 && input.index % every != 0) return propagator_.Propagate(gray);
+    std::vector<Instance> instances = memory_.Update(segmenter_->Segment(input));
+    if (every > 1) propagator_.Reset(gray, instances);
+    return instances;
+  });
+}
 
 FrameInstances DetSlamStage::Detect(const SegmenterInput& input) {
-  FrameInstances out;
-  if (segmenter_ == nullptr) return out;
-  const auto t0 = std::chrono::steady_clock::now();
-  out.instances = memory_.Update(segmenter_->Segment(input));
-  out.segmented = true;
-  out.segmentation_ms =
-      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-  return out;
+  if (segmenter_ == nullptr) return {};
+  return Timed([&] { return memory_.Update(segmenter_->Segment(input)); });
 }
 
 LabelledKeypoints DetSlamStage::Extract(const OrbExtractor& extractor, const cv::Mat& gray,
