@@ -18,7 +18,7 @@ void AddSynthCommand(CLI::App& app) {
   auto no_people = std::make_shared<bool>(false);
   auto cut = std::make_shared<std::string>();
   auto cover = std::make_shared<std::string>();
-  auto realism = std::make_shared<std::string>("easy");
+  auto realism = std::make_shared<std::string>("realistic");
   auto realism_off = std::make_shared<std::string>();
   std::string presets;
   for (const auto& p : SynthPresetNames()) presets += (presets.empty() ? "" : ", ") + p;
@@ -41,7 +41,9 @@ void AddSynthCommand(CLI::App& app) {
                   "colour) or 'realistic' (Kinect-v1-like depth at its own timestamp: 1/8 px "
                   "disparity steps, correlated noise, distortion, projector shadows, mixed edge "
                   "pixels, no return from dark or grazing surfaces, registration borders; rolling "
-                  "shutter, motion blur, lens softness, photon noise, exposure drift)")
+                  "shutter, motion blur, lens softness, photon noise, exposure drift; people "
+                  "who swing their legs, turn, come close and cross; a laptop moved in "
+                  "sitting_static)")
       ->capture_default_str();
   std::string effects;
   for (const auto& e : SynthRealismEffects()) effects += (effects.empty() ? "" : ", ") + e;

@@ -56,7 +56,9 @@ struct SynthOptions {
   bool people = true;                  // false: the static twin (same camera path, no people)
   bool motion_blur = false;            // blur colour images along the camera's image motion
   bool sensor_noise = true;            // false: ideal depth and colour (tests of the geometry)
-  SynthRealism realism = SynthRealism::kEasy;  // the sensor model (with sensor_noise)
+  // The sensor model (with sensor_noise). `detslam synth` defaults to kRealistic; the struct's
+  // default stays kEasy, the fast first generator the unit and integration tests were built on.
+  SynthRealism realism = SynthRealism::kEasy;
   // Effects of the realistic mode switched off, to measure what each costs (`--realism-off`):
   // names from SynthRealismEffects().
   std::vector<std::string> realism_off;
