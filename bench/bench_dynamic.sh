@@ -60,6 +60,13 @@ PY
 }
 export -f run_eval
 
+# ate_cell ATE TRACKED: the ATE (mm, one decimal), or "no ATE (TRACKED tracked)" for a run without
+# one (fewer than 3 poses, e.g. one that never initialised).
+ate_cell() {
+  if [[ $1 == nan ]]; then echo "no ATE ($2 tracked)"; else printf '%.1f' "$1"; fi
+}
+export -f ate_cell
+
 # One (preset, seed) job: writes $work/rows/<preset>_<seed>.{main,ablation}.
 job() {
   local preset=$1 seed=$2 seq="$work/${1}_$2"
@@ -73,19 +80,26 @@ job() {
   read -r depth depth_tr < <(run_eval "$seq" "$seq.depth" --segmenter "masks:$seq.dnnmasks" --no-geometric-check)
   read -r full full_tr < <(run_eval "$seq" "$seq.full" --segmenter "masks:$seq.dnnmasks")
   read -r gt gt_tr < <(run_eval "$seq" "$seq.gt" --segmenter gt)
+  # What the people hide costs by itself: the static twin with the people's ground-truth masks
+  # (the same regions removed, nobody in them).
+  mkdir -p "$seq.occl"
+  for f in rgb depth rgb.txt depth.txt groundtruth.txt settings.yaml; do ln -s "$seq.twin/$f" "$seq.occl/$f"; done
+  ln -s "$seq/masks" "$seq.occl/masks"
+  local occl occl_tr
+  read -r occl occl_tr < <(run_eval "$seq.occl" "$seq.occl.run" --segmenter gt)
   # The twin and the default filter with ORB-SLAM3's depth weighting (u_right residual).
-  local twin0 full0 nopre rawdepth
+  local twin0 full0 nopre rawdepth nopre_tr rawdepth_tr
   read -r twin0 _ < <(run_eval "$seq.twin" "$seq.twin.run0" --segmenter none --set RGBD.DisparitySigma=0)
   read -r full0 _ < <(run_eval "$seq" "$seq.full0" --segmenter "masks:$seq.dnnmasks" --set RGBD.DisparitySigma=0)
   # The default filter without the pre-mask (dynamic corners dropped only after the ORB spatial
   # distribution), and with the paper's raw min/max object depth instead of the dominant mode.
-  read -r nopre _ < <(run_eval "$seq" "$seq.fullnopre" --segmenter "masks:$seq.dnnmasks" --set Dynamic.PreMask=false)
-  read -r rawdepth _ < <(run_eval "$seq" "$seq.fullraw" --segmenter "masks:$seq.dnnmasks" --set Dynamic.DominantDepth=false)
+  read -r nopre nopre_tr < <(run_eval "$seq" "$seq.fullnopre" --segmenter "masks:$seq.dnnmasks" --set Dynamic.PreMask=false)
+  read -r rawdepth rawdepth_tr < <(run_eval "$seq" "$seq.fullraw" --segmenter "masks:$seq.dnnmasks" --set Dynamic.DominantDepth=false)
   python3 - "$preset" "$seed" "$twin" "$twin_tr" "$full" "$full_tr" "$none" "$none_tr" "$seq.full/run.json" \
-      "$seq.twin.run/eval.json" "$seq.full/eval.json" "$gt" "$work/rows/${preset}_$seed.vals" \
+      "$seq.twin.run/eval.json" "$seq.full/eval.json" "$gt" "$occl" "$work/rows/${preset}_$seed.vals" \
       >"$work/rows/${preset}_$seed.main" <<'PY'
 import json, sys
-preset, seed, twin, twin_tr, full, full_tr, none, none_tr, run, twin_eval, full_eval, gt, vals = sys.argv[1:]
+preset, seed, twin, twin_tr, full, full_tr, none, none_tr, run, twin_eval, full_eval, gt, occl, vals = sys.argv[1:]
 f = json.load(open(run))["per_frame"]
 cov = sum(1 for r in f if r["dynamic_instances"] > 0) / len(f) * 100
 ratio = float(full) / float(twin)
@@ -94,9 +108,9 @@ ok = "yes" if ratio <= 1.25 and tr == n else "no"
 rpe = [json.load(open(p))["rpe"]["trans_m_per_s"]["rmse"] * 1000 for p in (twin_eval, full_eval)]
 print(f"| {preset} | {seed} | {float(twin):.1f} ({twin_tr}) | {float(full):.1f} ({full_tr}) | {ratio:.2f} | {ok} | {float(none):.1f} ({none_tr}) | {cov:.0f} | {rpe[0]:.1f} / {rpe[1]:.1f} |")
 with open(vals, "w") as out:
-    print(twin, full, ratio, tr, n, rpe[0], rpe[1], none, gt, file=out)
+    print(twin, full, ratio, tr, n, rpe[0], rpe[1], none, gt, occl, file=out)
 PY
-  printf '| %s | %s | %.1f | %.1f | %.1f | %.1f | %.1f | %.1f | %.1f | %.1f | %.1f / %.1f (%.2f) |\n' "$preset" "$seed" "$twin" "$none" "$mask" "$depth" "$full" "$nopre" "$rawdepth" "$gt" \
+  printf '| %s | %s | %.1f | %.1f | %.1f | %.1f | %.1f | %.1f | %s | %s | %.1f | %.1f / %.1f (%.2f) |\n' "$preset" "$seed" "$twin" "$occl" "$none" "$mask" "$depth" "$full" "$(ate_cell "$nopre" "$nopre_tr")" "$(ate_cell "$rawdepth" "$rawdepth_tr")" "$gt" \
       "$twin0" "$full0" "$(python3 -c "print($full0 / $twin0)")" >"$work/rows/${preset}_$seed.ablation"
   if [[ " $spread_presets " == *" $preset "* ]]; then
     # Spread: the same twin and filtered runs with the keyframe far-point budget moved by +-20
@@ -117,7 +131,7 @@ print(f"| {preset} | {seed} | {cell(t)} | {cell(f)} | {' / '.join(f'{b / a:.2f}'
 PY
   fi
   [[ "$preset" == "walking_xyz" && "$seed" == "1" ]] && return 0  # kept for the every-k table
-  rm -rf "$seq" "$seq.twin" "$seq.dnnmasks" "$seq".*.run* "$seq".full* "$seq".none "$seq".mask "$seq".depth "$seq".gt
+  rm -rf "$seq" "$seq.twin" "$seq.dnnmasks" "$seq".*.run* "$seq".full* "$seq".none "$seq".mask "$seq".depth "$seq".gt "$seq".occl*
 }
 export -f job
 
@@ -140,9 +154,10 @@ for p in presets:
     twin = [float(x[0]) for x in v]; full = [float(x[1]) for x in v]; ratio = [float(x[2]) for x in v]
     tracked = sum(int(x[3]) for x in v); n = sum(int(x[4]) for x in v)
     rpe_t = [float(x[5]) for x in v]; rpe_f = [float(x[6]) for x in v]; gt = [float(x[8]) / float(x[0]) for x in v]
+    occl = [float(x[9]) / float(x[0]) for x in v]
     met = sum(1 for x in v if float(x[2]) <= 1.25 and x[3] == x[4])
     print(f"| {p} | {len(v)} | {cell(twin)} | {cell(full)} | {st.mean(ratio):.2f} ({max(ratio):.2f}) | "
-          f"{st.mean(gt):.2f} ({max(gt):.2f}) | {tracked}/{n} | {met}/{len(v)} | {cell(rpe_t)} | {cell(rpe_f)} |")
+          f"{st.mean(gt):.2f} ({max(gt):.2f}) | {st.mean(occl):.2f} ({max(occl):.2f}) | {tracked}/{n} | {met}/{len(v)} | {cell(rpe_t)} | {cell(rpe_f)} |")
 PY
 )
 ablation_rows=$(for p in $presets; do for s in $seeds; do cat "$work/rows/${p}_$s.ablation"; done; done)
@@ -226,11 +241,14 @@ done
   printf '%s\n' "$main_rows"
   echo
   echo "Over the seeds: ATE RMSE mm and RPE mm/s as mean ± sd (worst seed); filter / twin: the ratio"
-  echo "above, mean (worst); gt masks: the same ratio with the generator's masks. nan anywhere: a run"
+  echo "above, mean (worst); gt masks: the same ratio with the generator's masks; twin with the"
+  echo "people's masks: the static twin run with the people sequence's ground-truth masks (the same"
+  echo "regions removed from view, nobody in them): what losing that part of the view costs by itself."
+  echo "nan anywhere: a run"
   echo "that tracked fewer than 3 frames (no ATE)."
   echo
-  echo "| preset | seeds | static twin ATE | with filter (dnn) ATE | filter / twin mean (worst) | gt masks / twin mean (worst) | frames tracked | target met | RPE twin | RPE filter |"
-  echo "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
+  echo "| preset | seeds | static twin ATE | with filter (dnn) ATE | filter / twin mean (worst) | gt masks / twin mean (worst) | twin with the people's masks / twin mean (worst) | frames tracked | target met | RPE twin | RPE filter |"
+  echo "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
   printf '%s\n' "$summary_rows"
   echo
   echo "Ablation (ATE RMSE mm). \"+ geometric check\" adds the tracker's check for movers the segmenter"
@@ -243,8 +261,8 @@ done
   echo "twin and the default filter with ORB-SLAM3's depth weighting (\`--set RGBD.DisparitySigma=0\`:"
   echo "u_right residual with the keypoint's sigma), and their ratio."
   echo
-  echo "| preset | seed | static twin | none | masks only | masks + depth step | + geometric check (default) | PreMask off | raw min/max depth | gt masks | twin / filter, ORB-SLAM3 depth weighting (ratio) |"
-  echo "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
+  echo "| preset | seed | static twin | twin with the people's masks | none | masks only | masks + depth step | + geometric check (default) | PreMask off | raw min/max depth | gt masks | twin / filter, ORB-SLAM3 depth weighting (ratio) |"
+  echo "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
   printf '%s\n' "$ablation_rows"
   echo
   if [[ -n "$spread_rows" ]]; then
