@@ -244,8 +244,7 @@ done
   echo "above, mean (worst); gt masks: the same ratio with the generator's masks; twin with the"
   echo "people's masks: the static twin run with the people sequence's ground-truth masks (the same"
   echo "regions removed from view, nobody in them): what losing that part of the view costs by itself."
-  echo "nan anywhere: a run"
-  echo "that tracked fewer than 3 frames (no ATE)."
+  echo "nan or \"no ATE\": a run that tracked fewer than 3 frames."
   echo
   echo "| preset | seeds | static twin ATE | with filter (dnn) ATE | filter / twin mean (worst) | gt masks / twin mean (worst) | twin with the people's masks / twin mean (worst) | frames tracked | target met | RPE twin | RPE filter |"
   echo "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"

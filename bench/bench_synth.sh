@@ -36,7 +36,7 @@ PY
 }
 {
   echo "\`detslam synth\`, 640x480, $frames frames per preset, seed 1, $people_note, $(nproc) threads,"
-  echo "in both sensor models (\`--realism easy\`, the default for now, and \`--realism realistic\`)."
+  echo "in both sensor models (\`--realism realistic\`, the default, and \`--realism easy\`)."
   echo "Render fps: ray casting + people + sensor effects; total fps adds PNG encoding and atomic"
   echo "writes (and the one-off scene texture build). FAST corners (cv::FAST threshold 20, non-max"
   echo "suppression) and missing depth (fraction of depth pixels that are 0) on every 5th frame, mean"
