@@ -31,6 +31,14 @@ ImageBounds UndistortedBounds(const PinholeCamera& camera) {
   return b;
 }
 
+std::shared_ptr<const KeypointGrid> MakeKeypointGrid(const PinholeCamera& camera,
+                                                     const std::vector<cv::KeyPoint>& keypoints,
+                                                     const std::vector<Eigen::Vector2d>& undist) {
+  std::vector<int> octaves(keypoints.size());
+  for (size_t i = 0; i < keypoints.size(); ++i) octaves[i] = keypoints[i].octave;
+  return std::make_shared<KeypointGrid>(undist, octaves, UndistortedBounds(camera));
+}
+
 std::vector<float> SampleKeypointDepth(const std::vector<cv::KeyPoint>& keypoints,
                                        const cv::Mat& depth_m) {
   std::vector<float> depth(keypoints.size(), -1.0f);
@@ -60,9 +68,7 @@ std::shared_ptr<FrameFeatures> BuildFrameFeatures(const PinholeCamera& camera,
     const float d = f->depth[i];
     if (d > 0) f->u_right[i] = static_cast<float>(f->undist[i].x() - camera.bf / d);
   }
-  std::vector<int> octaves(n);
-  for (size_t i = 0; i < n; ++i) octaves[i] = keypoints[i].octave;
-  f->grid = std::make_shared<KeypointGrid>(f->undist, octaves, UndistortedBounds(camera));
+  f->grid = MakeKeypointGrid(camera, keypoints, f->undist);
   f->keypoints = std::move(keypoints);
   f->descriptors = std::move(descriptors);
   return f;

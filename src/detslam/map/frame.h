@@ -90,6 +90,12 @@ void ComputeFrameBow(const Vocabulary& vocabulary, FrameFeatures* features);
 // Bounds of undistorted keypoint positions (the image corners undistorted).
 ImageBounds UndistortedBounds(const PinholeCamera& camera);
 
+// The area grid over a frame's undistorted keypoints (`keypoints` give the octaves), bounded by
+// the undistorted image.
+std::shared_ptr<const KeypointGrid> MakeKeypointGrid(const PinholeCamera& camera,
+                                                     const std::vector<cv::KeyPoint>& keypoints,
+                                                     const std::vector<Eigen::Vector2d>& undist);
+
 // Each keypoint's depth from the depth image (CV_32FC1, metres; may be empty), read at the
 // detected (distorted) pixel (lround(x), lround(y)) as ORB-SLAM does; -1 where missing, zero or
 // not finite.

@@ -149,7 +149,6 @@ KeyFrame GetKeyFrame(ByteReader* r, const PinholeCamera& camera, int levels) {
   f->depth.resize(n);
   f->u_right.resize(n);
   f->descriptors = cv::Mat(static_cast<int>(n), static_cast<int>(kDescriptorBytes), CV_8UC1);
-  std::vector<int> octaves(n);
   for (uint64_t i = 0; i < n; ++i) {
     cv::KeyPoint& k = f->keypoints[i];
     k.pt.x = r->F32("keypoint");
@@ -162,7 +161,6 @@ KeyFrame GetKeyFrame(ByteReader* r, const PinholeCamera& camera, int levels) {
     if (k.octave < 0 || k.octave >= levels)
       r->Fail(where + ": keypoint " + std::to_string(i) + " octave " + std::to_string(k.octave) +
               " outside the pyramid");
-    octaves[i] = k.octave;
     f->undist[i].x() = r->F64("keypoint");
     f->undist[i].y() = r->F64("keypoint");
     f->depth[i] = r->F32("keypoint depth");
@@ -210,7 +208,7 @@ KeyFrame GetKeyFrame(ByteReader* r, const PinholeCamera& camera, int levels) {
     if (!kf.covisibility.emplace(other, weight).second)
       r->Fail(where + ": covisible keyframe " + std::to_string(other) + " repeated");
   }
-  f->grid = std::make_shared<KeypointGrid>(f->undist, octaves, UndistortedBounds(camera));
+  f->grid = MakeKeypointGrid(camera, f->keypoints, f->undist);
   kf.features = std::move(f);
   return kf;
 }

@@ -63,6 +63,8 @@ struct SynthOptions {
   // names from SynthRealismEffects().
   std::vector<std::string> realism_off;
   bool RealismOff(const std::string& effect) const;
+  // Frames come from the realistic sensor model (realism realistic with sensor noise on).
+  bool RealisticSensor() const { return realism == SynthRealism::kRealistic && sensor_noise; }
   double depth_scale_bias = 0.0;       // F: written depth x (1 + F sin^2(pi k / (N - 1))); 0 = off
   int cut_begin = 0;                   // frames cut_begin..cut_end-1 are not written (`--cut A:B`)
   int cut_end = 0;                     // cut_end <= cut_begin (default 0, 0): no cut

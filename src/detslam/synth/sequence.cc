@@ -71,8 +71,7 @@ double SynthFrame::Coverage() const {
 
 namespace {
 bool RealisticPeople(const SynthOptions& options) {
-  return options.realism == SynthRealism::kRealistic && options.sensor_noise &&
-         !options.RealismOff("people");
+  return options.RealisticSensor() && !options.RealismOff("people");
 }
 }  // namespace
 
@@ -112,8 +111,7 @@ SyntheticSequence::SyntheticSequence(const SynthOptions& options)
     kinect_.speckle_dropout = 0;
   }
   // The sequence's camera calibration (settings.yaml) states its rolling shutter.
-  if (options_.realism == SynthRealism::kRealistic && options_.sensor_noise)
-    camera_.rolling_shutter_readout = colour_camera_.readout_s;
+  if (options_.RealisticSensor()) camera_.rolling_shutter_readout = colour_camera_.readout_s;
   if (options_.preset == "sitting_static" && RealisticPeople(options_)) {
     // A closed-lid laptop on the desk in front of the person on the right (its back to the
     // camera); in the twin it stays where it is.
@@ -234,8 +232,7 @@ SynthFrame SyntheticSequence::Render(int k) const {
   f.stamp = StampOf(k);
   f.depth_stamp = DepthStampOf(k);
   f.world_from_cam = WorldFromCam(k);
-  if (options_.realism == SynthRealism::kRealistic && options_.sensor_noise)
-    return RenderRealistic(std::move(f));
+  if (options_.RealisticSensor()) return RenderRealistic(std::move(f));
   const std::vector<synth::PersonState> people =
       options_.people ? people_.At(t) : std::vector<synth::PersonState>{};
   synth::IdealFrame ideal = synth::RenderIdeal(scene_, looks_, people, camera_, f.world_from_cam);

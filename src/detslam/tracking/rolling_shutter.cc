@@ -52,9 +52,7 @@ std::shared_ptr<const FrameFeatures> CompensateRollingShutter(
       out->u_right[i] = static_cast<float>(out->undist[i].x() - camera.bf / p.z());
     }
   }
-  std::vector<int> octaves(in.size());
-  for (size_t i = 0; i < in.size(); ++i) octaves[i] = in.keypoints[i].octave;
-  out->grid = std::make_shared<KeypointGrid>(out->undist, octaves, UndistortedBounds(camera));
+  out->grid = MakeKeypointGrid(camera, out->keypoints, out->undist);
   return out;
 }
 
