@@ -6,11 +6,15 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cstdio>
 #include <cstdlib>
 #include <fstream>
 #include <iterator>
+#include <mutex>
 #include <stdexcept>
 #include <thread>
+
+#include <gtest/gtest.h>
 
 extern char** environ;
 
@@ -28,19 +32,53 @@ std::string ReadFileBytes(const std::filesystem::path& path) {
   return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
 }
 
+namespace {
+
+std::mutex temp_mutex;
+std::vector<std::filesystem::path>* temp_paths = nullptr;  // leaked on purpose: used at exit
+
+// At exit: removes the test's temporary folders and files if every test passed, else keeps them
+// for inspection and says where they are. DETSLAM_KEEP_TEST_OUTPUT=1 keeps them always.
+void RemoveTempPaths() {
+  std::lock_guard<std::mutex> lock(temp_mutex);
+  const bool keep = std::getenv("DETSLAM_KEEP_TEST_OUTPUT") != nullptr ||
+                    !::testing::UnitTest::GetInstance()->Passed();
+  for (const std::filesystem::path& p : *temp_paths) {
+    std::error_code ec;
+    if (keep) {
+      if (std::filesystem::exists(p, ec)) std::fprintf(stderr, "test output kept: %s\n", p.c_str());
+    } else {
+      std::filesystem::remove_all(p, ec);
+    }
+  }
+}
+
+}  // namespace
+
+void RemoveAtExit(const std::filesystem::path& path) {
+  std::lock_guard<std::mutex> lock(temp_mutex);
+  if (temp_paths == nullptr) {
+    temp_paths = new std::vector<std::filesystem::path>();
+    std::atexit(RemoveTempPaths);
+  }
+  temp_paths->push_back(path);
+}
+
 std::string TempDir(const std::string& name) {
   namespace fs = std::filesystem;
   const fs::path p =
       fs::temp_directory_path() / ("detslam_it_" + std::to_string(::getpid()) + "_" + name);
   fs::remove_all(p);
   fs::create_directories(p);
+  RemoveAtExit(p);
   return p.string();
 }
 
 std::string TempPath(const std::string& name) {
-  return (std::filesystem::temp_directory_path() /
-          ("detslam_" + std::to_string(::getpid()) + "_" + name))
-      .string();
+  const std::filesystem::path p = std::filesystem::temp_directory_path() /
+                                  ("detslam_" + std::to_string(::getpid()) + "_" + name);
+  RemoveAtExit(p);
+  return p.string();
 }
 
 ChildProcess::ChildProcess(const std::string& binary, const std::vector<std::string>& args,

@@ -18,10 +18,16 @@ int RunCommand(const std::string& binary, const std::string& args,
 // The whole file as bytes ("" if it cannot be read).
 std::string ReadFileBytes(const std::filesystem::path& path);
 
-// A fresh, empty folder for one test, per process (two test runs on one machine never share it).
+// Removes `path` (file or folder) when the test process exits, if every test passed; otherwise it is
+// kept and its path printed. DETSLAM_KEEP_TEST_OUTPUT=1 keeps everything.
+void RemoveAtExit(const std::filesystem::path& path);
+
+// A fresh, empty folder for one test, per process (two test runs on one machine never share it);
+// removed at exit as RemoveAtExit says.
 std::string TempDir(const std::string& name);
 
-// A path for one file of a test in the temporary folder, per process (nothing is created).
+// A path for one file of a test in the temporary folder, per process (nothing is created; whatever
+// the test writes there is removed at exit as RemoveAtExit says).
 std::string TempPath(const std::string& name);
 
 // A command started in the background (no shell), stdout and stderr into a log file, for tests

@@ -11,6 +11,7 @@
 #include <set>
 
 #include "detslam/core/check.h"
+#include "support/cli_runner.h"
 
 namespace detslam {
 namespace {
@@ -28,8 +29,7 @@ std::string ErrorOf(const std::function<void()>& fn) {
 
 // A v1.0 settings file with the camera and `more` appended.
 std::string WriteSettingsFile(const std::string& name, const std::string& more) {
-  const fs::path path =
-      fs::temp_directory_path() / ("detslam_keys_" + std::to_string(::getpid()) + "_" + name);
+  const fs::path path = testing::TempPath("keys_" + name);
   std::ofstream(path)
       << "%YAML:1.0\nFile.version: \"1.0\"\nCamera.type: \"PinHole\"\nCamera1.fx: 535.4\n"
          "Camera1.fy: 539.2\nCamera1.cx: 320.1\nCamera1.cy: 247.6\nCamera.width: 640\n"

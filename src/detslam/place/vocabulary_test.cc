@@ -10,6 +10,7 @@
 #include <set>
 
 #include "detslam/core/check.h"
+#include "support/cli_runner.h"
 
 namespace detslam {
 namespace {
@@ -89,7 +90,9 @@ fs::path TempPath(const std::string& name) {
   const ::testing::TestInfo* test = ::testing::UnitTest::GetInstance()->current_test_info();
   const std::string prefix = std::to_string(::getpid()) + "_" +
                              (test != nullptr ? std::string(test->name()) + "_" : std::string());
-  return fs::path(::testing::TempDir()) / (prefix + name);
+  const fs::path path = fs::path(::testing::TempDir()) / (prefix + name);
+  detslam::testing::RemoveAtExit(path);
+  return path;
 }
 
 TEST(VocabularyOptions, Check) {
