@@ -70,8 +70,14 @@ def summary(bench_text):
         if static:
             ates = [number(r["ATE RMSE mm"]) for r in static]
             tracked = "all frames tracked" if all(r["tracked"].split("/")[0] == r["tracked"].split("/")[1] for r in static) else "NOT all tracked"
-            rows.append((f"SLAM core, synthetic static ({len(static)} seeds)", tracked,
-                         f"ATE RMSE {min(ates):.1f}-{max(ates):.1f} mm"))
+            over = re.search(r"Over the (\d+) evaluation seeds: ATE RMSE (.+?) mm", slam)
+            seeds = re.search(r"preset \(.*?\), evaluation seeds ([0-9 ]+)", slam)
+            if over:
+                rows.append((f"SLAM core, synthetic static (evaluation seeds {seeds.group(1).strip() if seeds else '?'})",
+                             tracked, f"ATE RMSE {over.group(2)} mm (mean +- sd)"))
+            else:
+                rows.append((f"SLAM core, synthetic static ({len(static)} seeds)", tracked,
+                             f"ATE RMSE {min(ates):.1f}-{max(ates):.1f} mm"))
         loops = {r["sequence"]: r for t in run_tables for r in t if r.get("sequence", "").startswith("loop")}
         drift = dict(re.findall(r"End drift, loop closing (on|off): ([0-9.]+ cm over a [0-9.]+ m path \([0-9.]+ %\))", slam))
         for name, r in loops.items():
