@@ -21,11 +21,11 @@ bool DetSlamOptions::Check(std::string* error) const {
     if (error) *error = "mask propagation: " + e;
     return false;
   }
-  if (memory_frames < 0 || segment_every < 1 || keyframe_max_mask_age < 0 ||
+  if (memory_frames < 0 || depth_track_frames < 0 || segment_every < 1 || keyframe_max_mask_age < 0 ||
       keyframe_max_wait < 0 || keyframe_defer_min_inliers < 0) {
     if (error)
       *error =
-          "memory_frames must be >= 0, segment_every >= 1, keyframe_max_mask_age >= 0 and "
+          "memory_frames and depth_track_frames must be >= 0, segment_every >= 1, keyframe_max_mask_age >= 0 and "
           "keyframe_max_wait and keyframe_defer_min_inliers >= 0";
     return false;
   }
@@ -36,7 +36,7 @@ bool DetSlamOptions::Check(std::string* error) const {
 DetSlamStage::DetSlamStage(DetSlamOptions options, Segmenter* segmenter)
     : options_(std::move(options)),
       segmenter_(segmenter),
-      memory_(options_.memory_frames),
+      memory_(options_.memory_frames, 0.3, options_.depth_track_frames),
       propagator_(options_.propagation) {
   std::string error;
   DETSLAM_CHECK_MSG(options_.Check(&error), "invalid DetSlamOptions: " << error);
@@ -61,7 +61,7 @@ FrameInstances DetSlamStage::Segment(const SegmenterInput& input, const cv::Mat&
   return Timed([&] {
     const int every = options_.segment_every;
     if (every > 1 && input.index % every != 0) return propagator_.Propagate(gray);
-    std::vector<Instance> instances = memory_.Update(segmenter_->Segment(input));
+    std::vector<Instance> instances = memory_.Update(segmenter_->Segment(input), input.depth_m);
     if (every > 1) propagator_.Reset(gray, instances);
     return instances;
   });
@@ -69,7 +69,7 @@ FrameInstances DetSlamStage::Segment(const SegmenterInput& input, const cv::Mat&
 
 FrameInstances DetSlamStage::Detect(const SegmenterInput& input) {
   if (segmenter_ == nullptr) return {};
-  return Timed([&] { return memory_.Update(segmenter_->Segment(input)); });
+  return Timed([&] { return memory_.Update(segmenter_->Segment(input), input.depth_m); });
 }
 
 LabelledKeypoints DetSlamStage::Extract(const OrbExtractor& extractor, const cv::Mat& gray,

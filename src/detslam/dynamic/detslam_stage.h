@@ -28,6 +28,7 @@ struct DetSlamOptions {
   DynamicFilterOptions filter;  // mask step and depth step (Det-SLAM eqs. 1-6)
   bool premask = true;          // also drop dynamic corners before the ORB spatial distribution
   int memory_frames = 3;        // carry lost instances forward this many frames (0.1 s)
+  int depth_track_frames = 30;  // follow lost instances in depth for this many frames (0 = off)
   int segment_every = 1;        // segmenter on every k-th frame; masks follow the flow in between
   // Asynchronous segmentation (camera-rate mode): a frame whose masks were segmented on a frame
   // more than this many input frames older does not become a keyframe (no new map points from

@@ -248,6 +248,7 @@ void WriteRunOutputs(const RgbdSource& dataset, const Settings& settings, const 
                          {"mask_dilation_px", dyn.filter.mask_dilation_px},
                          {"premask", dyn.premask},
                          {"memory_frames", dyn.memory_frames},
+                         {"depth_track_frames", dyn.depth_track_frames},
                          {"geometric_check", dyn.geometric.enabled},
                          {"segment_every", dyn.segment_every},
                          {"keyframe_max_mask_age", dyn.keyframe_max_mask_age},

@@ -117,6 +117,7 @@ std::vector<Binding> MakeBindings() {
   k.push_back(Key("Dynamic.DominantDepth", "depth step: the object's depth from its dominant depth mode (off: the paper's raw min/max over the mask pixels)", [](auto& r) -> auto& { return r.run.slam.dynamic.filter.dominant_mode; }));
   k.push_back(Key("Dynamic.PreMask", "drop dynamic corners before the ORB spatial distribution", [](auto& r) -> auto& { return r.run.slam.dynamic.premask; }));
   k.push_back(Key("Dynamic.MemoryFrames", 0, kInf, "carry lost dynamic instances forward this many frames", [](auto& r) -> auto& { return r.run.slam.dynamic.memory_frames; }));
+  k.push_back(Key("Dynamic.DepthTrackFrames", 0, kInf, "follow lost dynamic instances in the depth image for this many frames (0 = off)", [](auto& r) -> auto& { return r.run.slam.dynamic.depth_track_frames; }));
   k.push_back(Key("Dynamic.GeometricCheck", "reject movers the segmenter missed by their residual against the tracked pose", [](auto& r) -> auto& { return r.run.slam.dynamic.geometric.enabled; }));
   k.push_back(Key("Dynamic.GeometricK", 0, kInf, "geometric check threshold in robust standard deviations above the median", [](auto& r) -> auto& { return r.run.slam.dynamic.geometric.threshold.k; }));
   k.push_back(Key("Dynamic.GeometricMinResidual", 0, kInf, "floor on the geometric check threshold (pixels)", [](auto& r) -> auto& { return r.run.slam.dynamic.geometric.threshold.min_threshold; }));
