@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "detslam/dynamic/dynamic_filter.h"
+
 namespace detslam {
 namespace {
 
@@ -14,13 +16,6 @@ double BoxIouOf(const cv::Rect& a, const cv::Rect& b) {
   return uni > 0 ? inter / uni : 0.0;
 }
 
-// The value at fraction q of the sorted values (nearest rank).
-float Quantile(std::vector<float>& v, double q) {
-  const size_t k = std::min(v.size() - 1, static_cast<size_t>(q * static_cast<double>(v.size())));
-  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(k), v.end());
-  return v[k];
-}
-
 }  // namespace
 
 bool DepthTrack::Follow(const Instance& previous, const cv::Mat& depth_m, Instance* followed) {
@@ -28,8 +23,9 @@ bool DepthTrack::Follow(const Instance& previous, const cv::Mat& depth_m, Instan
       previous.mask.size() != depth_m.size() || previous.box.area() <= 0)
     return false;
   const cv::Rect image(0, 0, depth_m.cols, depth_m.rows);
-  // The depth band of the previous mask (in this frame's depth: the person moves a few cm per frame,
-  // well inside the margin).
+  // The depth band of the previous mask in this frame's depth: its dominant depth mode (as the
+  // filter's depth step takes it), so that the background the person has uncovered since, now
+  // inside the old mask, does not count.
   std::vector<float> depths;
   int prev_area = 0;
   const cv::Rect prev_box = previous.box & image;
@@ -43,7 +39,11 @@ bool DepthTrack::Follow(const Instance& previous, const cv::Mat& depth_m, Instan
     }
   }
   if (prev_area == 0 || depths.size() < 20) return false;
-  const double lo = Quantile(depths, 0.1) - kBandMarginM, hi = Quantile(depths, 0.9) + kBandMarginM;
+  const DynamicFilterOptions filter;
+  const DepthRange mode = DominantDepthMode(depths, filter.depth_bin_m, filter.mode_window_m,
+                                            filter.mode_min_bin_fraction);
+  if (!mode.valid) return false;
+  const double lo = mode.min - kBandMarginM, hi = mode.max + kBandMarginM;
   const int gx = static_cast<int>(std::lround(kGrowFraction * prev_box.width));
   const int gy = static_cast<int>(std::lround(kGrowFraction * prev_box.height));
   const cv::Rect region =

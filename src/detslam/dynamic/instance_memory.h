@@ -7,8 +7,9 @@
 // slice or a close-up torso shows (entering or leaving the view, or filling half of it), and a
 // tracker that then takes their keypoints for static ones follows them. A lost instance with a
 // mask is instead followed in the depth image, for at most `depth_track_age` frames: its new mask
-// is the connected region of pixels whose depth lies in the instance's depth band (the 10th-90th
-// percentile of its mask's depths, widened by DepthTrack::kBandMarginM) inside its box widened by
+// is the connected region of pixels whose depth lies in the instance's depth band (the dominant
+// depth mode of its previous mask's pixels in the new depth image, as the filter's depth step
+// takes it, widened by DepthTrack::kBandMarginM) inside its box widened by
 // DepthTrack::kGrowFraction, the component that overlaps its previous mask most; it stops when that
 // region keeps less than DepthTrack::kMinAreaRatio or grows beyond DepthTrack::kMaxAreaRatio of
 // the previous mask (the person has left or merged with the background) and then falls back to the
