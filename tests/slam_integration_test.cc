@@ -139,14 +139,11 @@ TEST(IntegrationSlamDynamic, GroundTruthMasksRemoveThePeople) {
 // ../shared/models) on people textured with the real TUM cut-outs: every frame tracked, ATE at most
 // 1.5x the static twin's, and without the filter clearly worse. Seed 4 is neither a tuning seed
 // (1-3) nor an evaluation seed (101+) of the benchmarks.
-// DISABLED because it FAILS today (2026-12-04): dnn 3.65 mm against the twin's 2.16 mm (1.69x;
-// ground-truth masks 2.14 mm, no filter 482 mm). The detectors miss a person cut by the left image
-// border (a torso without a head) for frames 114-121, longer than Dynamic.MemoryFrames (3) carries
-// the lost instance, and the pose drifts by up to 3.2 cm while its keypoints count as static.
-// A longer memory fixes this sequence (10 frames: 2.27 mm) but not the tuning seeds (mean over the
-// four walking presets x seeds 1-3: 2.47 / 2.48 / 2.50 mm for 3 / 6 / 10 frames), so the default
-// stays; enable this test with the fix (README, Not done yet).
-TEST(DataSlamDynamic, DISABLED_DnnSegmenterKeepsTheStaticTwinsAccuracy) {
+// It failed until the lost-instance depth tracking (Dynamic.DepthTrackFrames): the detectors miss
+// a person cut by the left image border (a torso without a head) for frames 114-121, longer than
+// the 3 frames a lost instance was carried, and the pose drifted by up to 3.2 cm (1.69x the twin);
+// with the person followed in depth it is 0.98x (replayed masks, 2026-12-04).
+TEST(DataSlamDynamic, DnnSegmenterKeepsTheStaticTwinsAccuracy) {
   DETSLAM_REQUIRE_SHARED("data/people/person_1.png");
   DETSLAM_REQUIRE_SHARED("models/yolox_nano/yolox_nano.onnx");
   SynthOptions so;
