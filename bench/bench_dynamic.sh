@@ -233,7 +233,8 @@ done
   echo "run on every 2nd segmented frame, its boxes reused in between) for the people YOLOX misses, MediaPipe selfie person masks on each person box (the box pixels"
   echo "at the person's dominant depth where the selfie mask fills < 25 % of the box) (../shared/models);"
   echo "filter defaults: alpha = 0.1, mask dilation 15 px, lost detections carried 3 frames (these two"
-  echo "were chosen on walking_xyz seed 1, 300 frames), geometric check on. Target: with the filter,"
+  echo "were chosen on walking_xyz seed 1, 300 frames), lost detections followed in depth for up to 30"
+  echo "frames (Dynamic.DepthTrackFrames, chosen on the tuning seeds), geometric check on. Target: with the filter,"
   echo "every frame tracked and ATE <= 1.25 x the static twin's (ratio of the unrounded ATEs)."
   echo
   echo "| preset | seed | static twin | with filter (dnn) | ratio | target met | without filter | frames with people detected % | RPE twin / filter |"
