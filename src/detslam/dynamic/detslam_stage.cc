@@ -61,7 +61,7 @@ FrameInstances DetSlamStage::Segment(const SegmenterInput& input, const cv::Mat&
   return Timed([&] {
     const int every = options_.segment_every;
     if (every > 1 && input.index % every != 0) return propagator_.Propagate(gray);
-    std::vector<Instance> instances = memory_.Update(segmenter_->Segment(input), input.depth_m);
+    std::vector<Instance> instances = memory_.Update(segmenter_->Segment(input), input.depth_m, every);
     if (every > 1) propagator_.Reset(gray, instances);
     return instances;
   });
@@ -69,7 +69,12 @@ FrameInstances DetSlamStage::Segment(const SegmenterInput& input, const cv::Mat&
 
 FrameInstances DetSlamStage::Detect(const SegmenterInput& input) {
   if (segmenter_ == nullptr) return {};
-  return Timed([&] { return memory_.Update(segmenter_->Segment(input), input.depth_m); });
+  // The detector picks its frames (it may skip some): the memory's depth tracking counts frames.
+  const int elapsed = last_detected_index_ >= 0 && input.index > last_detected_index_
+                          ? static_cast<int>(input.index - last_detected_index_)
+                          : 1;
+  last_detected_index_ = input.index;
+  return Timed([&] { return memory_.Update(segmenter_->Segment(input), input.depth_m, elapsed); });
 }
 
 LabelledKeypoints DetSlamStage::Extract(const OrbExtractor& extractor, const cv::Mat& gray,

@@ -87,7 +87,8 @@ class DetSlamStage {
  private:
   DetSlamOptions options_;
   Segmenter* segmenter_;
-  InstanceMemory memory_;      // detections lost for a frame or two
+  InstanceMemory memory_;
+  int64_t last_detected_index_ = -1;  // Detect(): the previous frame it ran on      // detections lost for a frame or two
   MaskPropagator propagator_;  // masks between segmented frames (segment_every > 1)
 };
 

@@ -84,10 +84,10 @@ bool DepthTrack::Follow(const Instance& previous, const cv::Mat& depth_m, Instan
 }
 
 std::vector<Instance> InstanceMemory::Update(const std::vector<Instance>& current,
-                                             const cv::Mat& depth_m) {
+                                             const cv::Mat& depth_m, int frames_elapsed) {
   std::vector<Instance> out = current;
   std::vector<Remembered> next;
-  for (const Instance& inst : current) next.push_back({inst, 0, false});
+  for (const Instance& inst : current) next.push_back({inst, 0, 0, false});
   for (const Remembered& r : remembered_) {
     bool covered = false;
     for (const Instance& c : current) {
@@ -95,15 +95,15 @@ std::vector<Instance> InstanceMemory::Update(const std::vector<Instance>& curren
         covered = true;
     }
     if (covered) continue;
-    const int age = r.age + 1;
+    const int age = r.age + 1, frames = r.frames + frames_elapsed;
     Instance followed;
-    if (age <= depth_track_age_ && (age == 1 || r.depth_tracked) &&
+    if (frames <= depth_track_age_ && (age == 1 || r.depth_tracked) &&
         DepthTrack::Follow(r.instance, depth_m, &followed)) {
       out.push_back(followed);
-      next.push_back({std::move(followed), age, true});
+      next.push_back({std::move(followed), age, frames, true});
     } else if (age <= max_age_) {
       out.push_back(r.instance);
-      next.push_back({r.instance, age, false});
+      next.push_back({r.instance, age, frames, false});
     }
   }
   remembered_ = std::move(next);

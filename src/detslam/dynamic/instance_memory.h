@@ -40,13 +40,17 @@ class InstanceMemory {
       : max_age_(max_age), depth_track_age_(depth_track_age), min_iou_(min_iou) {}
 
   // Returns `current` plus remembered instances that are not covered by it. `depth_m` (may be
-  // empty: no depth tracking) is the frame's depth, CV_32FC1 metres.
-  std::vector<Instance> Update(const std::vector<Instance>& current, const cv::Mat& depth_m = {});
+  // empty: no depth tracking) is the frame's depth, CV_32FC1 metres. `frames_elapsed`: frames since
+  // the previous call (the segmenter may run on every k-th frame only); depth_track_age counts
+  // frames, max_age counts calls.
+  std::vector<Instance> Update(const std::vector<Instance>& current, const cv::Mat& depth_m = {},
+                               int frames_elapsed = 1);
 
  private:
   struct Remembered {
     Instance instance;
-    int age = 0;
+    int age = 0;     // calls since it was last detected
+    int frames = 0;  // frames since it was last detected
     bool depth_tracked = false;  // followed in depth since it was lost (else carried unchanged)
   };
   int max_age_;

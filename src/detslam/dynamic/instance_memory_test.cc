@@ -96,6 +96,16 @@ TEST(InstanceMemory, FollowsALostPersonInDepthForAtMostDepthTrackAgeFrames) {
   EXPECT_TRUE(memory.Update({}, DepthWithPerson(150)).empty());
 }
 
+// With the segmenter on every k-th frame only, depth tracking still ends after depth_track_age
+// frames (not calls).
+TEST(InstanceMemory, DepthTrackAgeCountsFrames) {
+  InstanceMemory memory(0, 0.3, 6);
+  memory.Update({PersonWithMask(100)}, DepthWithPerson(100), 3);
+  EXPECT_EQ(memory.Update({}, DepthWithPerson(105), 3).size(), 1u);  // 3 frames
+  EXPECT_EQ(memory.Update({}, DepthWithPerson(110), 3).size(), 1u);  // 6 frames
+  EXPECT_TRUE(memory.Update({}, DepthWithPerson(115), 3).empty());   // 9 frames
+}
+
 TEST(InstanceMemory, FallsBackToThePlainCarryWhenDepthCannotFollow) {
   InstanceMemory memory(2, 0.3, 10);
   memory.Update({PersonWithMask(100)}, DepthWithPerson(100));
