@@ -12,9 +12,10 @@
 # The dnn masks are computed once per sequence with `detslam segment` and replayed (masks:DIR),
 # which gives the same result as --segmenter dnn. The (preset, seed) jobs run JOBS at a time
 # (sequential-mode runs are deterministic, so their accuracy does not depend on the load). Then,
-# alone on the machine, segmenting every k-th frame (k = 1, 2, 3, 5): accuracy from replayed
-# masks, and the frame rate of the threaded pipeline with the live dnn backend.
-# Writes docs/BENCHMARKS.md (section dynamic).
+# alone on the machine, segmenting every k-th frame (k = 1, 2, 3, 5) on walking_xyz, the first
+# evaluation seed: accuracy from replayed masks, and the frame rate of the threaded pipeline with
+# the live dnn backend.
+# Writes docs/BENCHMARKS.md (sections dynamic and dynamic-k).
 # Usage: bench/bench_dynamic.sh [path/to/detslam]
 #   env: PRESETS="walking_xyz walking_static walking_rpy walking_halfsphere sitting_static"
 #        SEEDS="101 102 103" (evaluation seeds; defaults were chosen on the tuning seeds 1-3 only)
@@ -22,6 +23,8 @@
 #        FRAMES=300  JOBS=2  KS="1 2 3 5"
 #        SPREAD_PRESETS="walking_xyz" (presets whose runs are repeated with a perturbed setting)
 #        REPEATS=3 (live threaded runs per configuration of the every-k table; median reported)
+#        PARTS="main k" (main: the presets x seeds tables, section dynamic; k: the every-k table,
+#        section dynamic-k, on walking_xyz with K_SEED, default the first of SEEDS)
 set -euo pipefail
 here="$(cd "$(dirname "$0")" && pwd)"
 root="$(dirname "$here")"
@@ -34,11 +37,13 @@ jobs="${JOBS:-2}"
 ks="${KS:-1 2 3 5}"
 repeats="${REPEATS:-3}"
 spread_presets="${SPREAD_PRESETS:-walking_xyz}"
+parts=" ${PARTS:-main k} "
+kseed="${K_SEED:-${seeds%% *}}"
 source "$here/bench_lib.sh"  # shellcheck source=bench/bench_lib.sh
 need_people_and_models
 work="$(mktemp -d)"
 trap 'rm -rf "$work"' EXIT
-export bin models people frames work here spread_presets realism
+export bin models people frames work here spread_presets realism kseed
 
 # run_eval DATASET OUT [run options...] -> prints "ate_mm tracked/frames"
 run_eval() {
@@ -130,11 +135,12 @@ cell = lambda a: " / ".join(f"{x:.1f}" for x in a)
 print(f"| {preset} | {seed} | {cell(t)} | {cell(f)} | {' / '.join(f'{b / a:.2f}' for a, b in zip(t, f))} |")
 PY
   fi
-  [[ "$preset" == "walking_xyz" && "$seed" == "1" ]] && return 0  # kept for the every-k table
+  [[ "$preset" == "walking_xyz" && "$seed" == "$kseed" ]] && return 0  # kept for the every-k table
   rm -rf "$seq" "$seq.twin" "$seq.dnnmasks" "$seq".*.run* "$seq".full* "$seq".none "$seq".mask "$seq".depth "$seq".gt "$seq".occl*
 }
 export -f job
 
+if [[ "$parts" == *" main "* ]]; then
 mkdir -p "$work/rows"
 list=()
 for preset in $presets; do for seed in $seeds; do list+=("$preset $seed"); done; done
@@ -162,12 +168,14 @@ PY
 )
 ablation_rows=$(for p in $presets; do for s in $seeds; do cat "$work/rows/${p}_$s.ablation"; done; done)
 spread_rows=$(cat "$work"/rows/*.spread 2>/dev/null || true)
+fi
 
-# Segmenting every k-th frame: walking_xyz seed 1 (generated above unless PRESETS/SEEDS skip it).
+# Segmenting every k-th frame: walking_xyz seed K_SEED (generated above unless PRESETS/SEEDS skip it).
+if [[ "$parts" == *" k "* ]]; then
 k_rows=""
-kseq="$work/walking_xyz_1"
+kseq="$work/walking_xyz_$kseed"
 if [[ ! -d "$kseq" ]]; then
-  "$bin" synth --preset walking_xyz --seed 1 --frames "$frames" --realism "$realism" --people "$people" --out "$kseq" >/dev/null 2>&1
+  "$bin" synth --preset walking_xyz --seed "$kseed" --frames "$frames" --realism "$realism" --people "$people" --out "$kseq" >/dev/null 2>&1
   "$bin" segment --dataset "$kseq" --models "$models" --out "$kseq.dnnmasks" >/dev/null 2>&1
 fi
 # Configurations of the every-k table: LABEL|SEGMENT-OPTIONS|RUN-OPTIONS (k = 1 is the default).
@@ -223,6 +231,9 @@ PY
 )$'\n'
 done
 
+fi
+
+if [[ "$parts" == *" main "* ]]; then
 {
   echo "Synthetic walking presets (\`detslam synth --realism $realism\`; no real dynamic sequence was run"
   echo "here: the full TUM and Bonn dynamic sequences are not on this machine), $frames frames each,"
@@ -275,8 +286,16 @@ done
     printf '%s\n' "$spread_rows"
     echo
   fi
+} >"$work/section.md"
+python3 "$here/update_section.py" dynamic "bench/bench_dynamic.sh (PARTS=main PRESETS=\"$presets\" SEEDS=\"$seeds\" REALISM=$realism FRAMES=$frames JOBS=$jobs SPREAD_PRESETS=\"$spread_presets\")" <"$work/section.md"
+cat "$work/section.md"
+fi
+if [[ "$parts" == *" k "* ]]; then
+{
   echo "Segmenting only every k-th frame (\`--segment-every K\`; masks follow the optical flow and grow"
-  echo "2 px per frame in between), walking_xyz seed 1 (a tuning seed). Accuracy from replayed dnn masks"
+  echo "2 px per frame in between), synthetic walking_xyz (\`--realism $realism\`, $frames frames), seed $kseed"
+  if (( kseed <= 3 )); then echo "(a tuning seed)."; else echo "(an evaluation seed: nothing was chosen on it)."; fi
+  echo "Accuracy from replayed dnn masks"
   echo "(sequential), and the live threaded run's own trajectory (the median-fps run) beside it;"
   echo "speed of the whole threaded pipeline with the live dnn segmenter (\`--threaded\`:"
   echo "loading+segmentation, extraction+filter, tracking and local mapping threads), measured alone"
@@ -288,8 +307,9 @@ done
   echo "| k | ATE mm (tracked) | live run's own ATE mm (tracked) | fps (threaded, live dnn) | segmentation + propagation ms per frame (mean) | extraction ms (median) | tracking ms (median) |"
   echo "|---:|---:|---:|---:|---:|---:|---:|"
   printf '%s' "$k_rows"
-} >"$work/section.md"
-python3 "$here/update_section.py" dynamic "bench/bench_dynamic.sh (PRESETS=\"$presets\" SEEDS=\"$seeds\" REALISM=$realism FRAMES=$frames JOBS=$jobs KS=\"$ks\" SPREAD_PRESETS=\"$spread_presets\" REPEATS=$repeats)" <"$work/section.md"
-cat "$work/section.md"
+} >"$work/section-k.md"
+python3 "$here/update_section.py" dynamic-k "bench/bench_dynamic.sh (PARTS=k K_SEED=$kseed REALISM=$realism FRAMES=$frames KS=\"$ks\" REPEATS=$repeats)" <"$work/section-k.md"
+cat "$work/section-k.md"
+fi
 python3 "$here/readme_summary.py"
 python3 "$here/plot_dynamic.py"
