@@ -17,18 +17,18 @@
 # and writes the tables into docs/BENCHMARKS.md (sections place-loops, place-loops-drift,
 # place-loops-kidnap, place-loops-false: one per part) via bench/update_section.py.
 # Usage: bench/bench_loops.sh [path/to/detslam]
-#   (env: SEEDS="1 2 3", LOOP_SEEDS="5 6 7", LOOP_FRAMES=1200, LONG_FRAMES=2250, DRIFT_BIASES="0.5 -0.5",
+#   (env: SEEDS="101 102 103", LOOP_SEEDS="101 102 103", LOOP_FRAMES=1200, LONG_FRAMES=2250, DRIFT_BIASES="0.5 -0.5",
 #    KIDNAP_TARGETS="880 900 920 940 980 1040", PRESETS="static walking_xyz ...",
 #    JOBS=2, FALSE_LOOP_M=4, PARTS="A B C D": the parts to run; each writes its own section)
 set -euo pipefail
-# The synthetic sensor model this benchmark's published section was measured with (easy until it
-# is re-run on the realistic generator, `detslam synth`'s default).
-export realism="${REALISM:-easy}"
+# The synthetic sensor model (`detslam synth --realism`): realistic, the generator's default;
+# REALISM=easy gives the first generator's sequences.
+export realism="${REALISM:-realistic}"
 here="$(cd "$(dirname "$0")" && pwd)"
 root="$(dirname "$here")"
 bin="${1:-$root/build/bin/detslam}"
-seeds="${SEEDS:-1 2 3}"
-loop_seeds="${LOOP_SEEDS:-5 6 7}"
+seeds="${SEEDS:-101 102 103}"
+loop_seeds="${LOOP_SEEDS:-101 102 103}"
 loop_frames="${LOOP_FRAMES:-1200}"
 long_frames="${LONG_FRAMES:-2250}"
 biases="${DRIFT_BIASES:-0.5 -0.5}"
