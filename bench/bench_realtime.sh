@@ -40,7 +40,7 @@ frames="${FRAMES:-300}"
 parts="${PARTS:-live tracking}"
 long_frames="${LONG_FRAMES:-20000}"
 long_seed="${LONG_SEED:-101}"
-settings_line="bench/bench_realtime.sh (PRESETS=\"$presets\" SEEDS=\"$seeds\" FRAMES=$frames PARTS=\"$parts\"$([[ " $parts " == *" long "* ]] && echo " LONG_FRAMES=$long_frames LONG_SEED=$long_seed") REALISM=$realism)"
+settings_line="bench/bench_realtime.sh (PRESETS=\"$presets\" SEEDS=\"$seeds\" FRAMES=$frames PARTS=\"$parts\"$([[ " $parts " != *" long "* ]] || echo " LONG_FRAMES=$long_frames LONG_SEED=$long_seed") REALISM=$realism)"
 work="$(mktemp -d)"
 trap 'rm -rf "$work"' EXIT
 bench_name=bench_realtime
