@@ -36,7 +36,7 @@ bool DetSlamOptions::Check(std::string* error) const {
 DetSlamStage::DetSlamStage(DetSlamOptions options, Segmenter* segmenter)
     : options_(std::move(options)),
       segmenter_(segmenter),
-      memory_(options_.memory_frames, 0.3, options_.depth_track_frames),
+      memory_(options_.memory_frames, InstanceMemory::kDefaultMinIou, options_.depth_track_frames),
       propagator_(options_.propagation) {
   std::string error;
   DETSLAM_CHECK_MSG(options_.Check(&error), "invalid DetSlamOptions: " << error);

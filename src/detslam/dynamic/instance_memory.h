@@ -36,7 +36,9 @@ struct DepthTrack {
 
 class InstanceMemory {
  public:
-  explicit InstanceMemory(int max_age, double min_iou = 0.3, int depth_track_age = 0)
+  // A remembered instance counts as found again when a current one overlaps it by this IoU.
+  static constexpr double kDefaultMinIou = 0.3;
+  explicit InstanceMemory(int max_age, double min_iou = kDefaultMinIou, int depth_track_age = 0)
       : max_age_(max_age), depth_track_age_(depth_track_age), min_iou_(min_iou) {}
 
   // Returns `current` plus remembered instances that are not covered by it. `depth_m` (may be

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "detslam/core/id_stamps.h"
 #include "detslam/core/rng.h"
 #include "detslam/dynamic/geometric_check.h"
 #include "detslam/map/map.h"
@@ -176,6 +177,8 @@ class Tracker {
   Timestamp lost_since_;
   std::vector<KeyFrameId> local_keyframes_;
   std::vector<LandmarkId> local_landmarks_;
+  IdStamps local_landmark_set_;  // local_landmarks_ as a set (rebuilt each frame)
+  IdStamps matched_set_;         // the current frame's matched landmarks (TrackLocalMap)
   FrameScratch scratch_;
 };
 

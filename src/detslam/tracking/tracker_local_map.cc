@@ -48,10 +48,10 @@ void Tracker::UpdateLocalMap(const Map& map, const Frame& frame) {
   }
   if (best != kNoKeyFrame) reference_kf_ = best;
   local_landmarks_.clear();
-  std::set<LandmarkId> seen;
+  local_landmark_set_.Clear();
   for (KeyFrameId kf_id : local_keyframes_) {
     for (LandmarkId id : map.keyframe(kf_id).landmarks) {
-      if (id != kNoLandmark && seen.insert(id).second) local_landmarks_.push_back(id);
+      if (id != kNoLandmark && local_landmark_set_.Insert(id)) local_landmarks_.push_back(id);
     }
   }
 }
@@ -60,14 +60,15 @@ bool Tracker::TrackLocalMap(Map& map, Frame* frame, int* inliers) {
   UpdateLocalMap(map, *frame);
   // Project local landmarks that are not matched yet.
   std::vector<ProjectionCandidate> candidates;
-  std::set<LandmarkId> matched;
+  std::vector<LandmarkId> matched;  // the frame's landmarks, each once
+  matched_set_.Clear();
   for (LandmarkId id : frame->landmarks) {
-    if (id != kNoLandmark) matched.insert(id);
+    if (id != kNoLandmark && matched_set_.Insert(id)) matched.push_back(id);
   }
   const Rigid3d& pose = *frame->cam_from_world;
   const Eigen::Vector3d center = pose.Inverse().translation();
   for (LandmarkId id : local_landmarks_) {
-    if (matched.count(id)) continue;
+    if (matched_set_.Contains(id)) continue;
     Landmark& lm = map.landmark(id);
     // Frustum check (counts as "visible" for the found ratio).
     const Eigen::Vector3d pc = pose * lm.position;
