@@ -54,6 +54,13 @@ def number(cell):
     return float(m.group(0)) if m else float("nan")
 
 
+def sensor_model(body):
+    """The generator's sensor model a section was measured with, from its stamp (sections written
+    before `REALISM` was recorded used the easy one)."""
+    m = re.search(r"REALISM=(\w+)", body)
+    return m.group(1) if m else "easy"
+
+
 def summary(bench_text):
     rows = []
     slam = section(bench_text, "slam")
@@ -87,8 +94,7 @@ def summary(bench_text):
     dyn = section(bench_text, "dynamic")
     if dyn:
         main = table_with(dyn, "ratio")
-        realism = re.search(r"REALISM=(\w+)", dyn)
-        sensor = f"synthetic, {realism.group(1) if realism else 'easy'} sensor"
+        sensor = f"synthetic, {sensor_model(dyn)} sensor"
         by_preset = {}
         for r in main:
             by_preset.setdefault(r["preset"], []).append(r)
@@ -106,8 +112,7 @@ def summary(bench_text):
     # The every-k table: its own section since it runs on one sequence (older files: in dynamic).
     dyn_k = section(bench_text, "dynamic-k") or dyn
     if dyn_k:
-        realism = re.search(r"REALISM=(\w+)", dyn_k)
-        sensor = f"synthetic, {realism.group(1) if realism else 'easy'} sensor"
+        sensor = f"synthetic, {sensor_model(dyn_k)} sensor"
         k_seed = re.search(r"K_SEED=(\d+)", dyn_k)
         k_seed = k_seed.group(1) if k_seed else "1"
         ks = next((t for t in tables(dyn_k) if t and "k" in t[0] and "fps (threaded, live dnn)" in t[0]), [])
@@ -209,8 +214,7 @@ def summary(bench_text):
                  "realtime-long"):
         body = section(bench_text, name)
         if body:
-            m = re.search(r"REALISM=(\w+)", body)
-            sensors.setdefault(m.group(1) if m else "easy", []).append(f"`{name}`")
+            sensors.setdefault(sensor_model(body), []).append(f"`{name}`")
     sensor_text = "; ".join(f"{k} sensor: {', '.join(v)}" for k, v in sorted(sensors.items(), reverse=True))
     head = (f"_Condensed by `bench/readme_summary.py` from docs/BENCHMARKS.md sections "
             f"{', '.join(sources) or '(none yet)'}; details, machine and settings there. Synthetic "
