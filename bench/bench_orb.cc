@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "detslam/core/allocator.h"
 #include "detslam/features/matcher.h"
 #include "detslam/features/orb_extractor.h"
 
@@ -67,4 +68,13 @@ BENCHMARK(BM_MatchBruteForce)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 
-BENCHMARK_MAIN();
+// Freed frame-sized buffers stay for the next iteration, as in the pipeline's steady state
+// (detslam/core/allocator.h).
+int main(int argc, char** argv) {
+  detslam::KeepFreedMemoryForReuse();
+  benchmark::Initialize(&argc, argv);
+  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  return 0;
+}

@@ -56,12 +56,19 @@ FrameInstances Timed(SegmentFn&& segment) {
 }
 }  // namespace
 
+std::vector<Instance> DetSlamStage::Used(std::vector<Instance> instances) const {
+  instances.erase(std::remove_if(instances.begin(), instances.end(),
+                                 [&](const Instance& i) { return !options_.filter.Uses(i); }),
+                  instances.end());
+  return instances;
+}
+
 FrameInstances DetSlamStage::Segment(const SegmenterInput& input, const cv::Mat& gray) {
   if (segmenter_ == nullptr) return {};
   return Timed([&] {
     const int every = options_.segment_every;
     if (every > 1 && input.index % every != 0) return propagator_.Propagate(gray);
-    std::vector<Instance> instances = memory_.Update(segmenter_->Segment(input), input.depth_m, every);
+    std::vector<Instance> instances = memory_.Update(Used(segmenter_->Segment(input)), input.depth_m, every);
     if (every > 1) propagator_.Reset(gray, instances);
     return instances;
   });
@@ -74,7 +81,7 @@ FrameInstances DetSlamStage::Detect(const SegmenterInput& input) {
                           ? static_cast<int>(input.index - last_detected_index_)
                           : 1;
   last_detected_index_ = input.index;
-  return Timed([&] { return memory_.Update(segmenter_->Segment(input), input.depth_m, elapsed); });
+  return Timed([&] { return memory_.Update(Used(segmenter_->Segment(input)), input.depth_m, elapsed); });
 }
 
 LabelledKeypoints DetSlamStage::Extract(const OrbExtractor& extractor, const cv::Mat& gray,

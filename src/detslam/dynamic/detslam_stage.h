@@ -68,8 +68,8 @@ class DetSlamStage {
   // `segmenter` may be null: then Segment reports no instances and Extract labels nothing.
   DetSlamStage(DetSlamOptions options, Segmenter* segmenter);
 
-  // Loader side: the dynamic instances of the frame `input` describes (`gray`: its CV_8UC1 image,
-  // for the mask propagation). Frames must come in input order.
+  // Loader side: the dynamic instances (those the filter uses) of the frame `input` describes
+  // (`gray`: its CV_8UC1 image, for the mask propagation). Frames must come in input order.
   FrameInstances Segment(const SegmenterInput& input, const cv::Mat& gray);
 
   // Asynchronous segmentation's thread (frames in input order, not necessarily every frame): the
@@ -85,10 +85,15 @@ class DetSlamStage {
                             const std::vector<Instance>* instances) const;
 
  private:
+  // The instances the filter acts on (DynamicFilterOptions::Uses): the others (static classes,
+  // low scores) are dropped before the memory, the propagation and the keyframe masks, which
+  // would spend time on them for nothing (a YOLOX frame of a room has books, chairs, screens).
+  std::vector<Instance> Used(std::vector<Instance> instances) const;
+
   DetSlamOptions options_;
   Segmenter* segmenter_;
-  InstanceMemory memory_;
-  int64_t last_detected_index_ = -1;  // Detect(): the previous frame it ran on      // detections lost for a frame or two
+  InstanceMemory memory_;  // detections lost for a frame or two
+  int64_t last_detected_index_ = -1;  // Detect(): the previous frame it ran on
   MaskPropagator propagator_;  // masks between segmented frames (segment_every > 1)
 };
 

@@ -43,10 +43,6 @@ void CheckDepth(const cv::Mat& depth_m) {
   }
 }
 
-bool UsesInstance(const Instance& instance, const DynamicFilterOptions& options) {
-  return instance.score >= options.min_score && options.IsDynamicClass(instance.class_name);
-}
-
 // The image size the instances refer to: the depth image's, else the first mask's, else the
 // smallest size that holds every box.
 cv::Size InferImageSize(const std::vector<Instance>& instances, const cv::Mat& depth_m) {
@@ -116,6 +112,10 @@ bool DynamicFilterOptions::Check(std::string* error) const {
     if (name.empty()) return fail("dynamic_classes must not contain an empty name");
   }
   return true;
+}
+
+bool DynamicFilterOptions::Uses(const Instance& instance) const {
+  return instance.score >= min_score && IsDynamicClass(instance.class_name);
 }
 
 bool DynamicFilterOptions::IsDynamicClass(const std::string& class_name) const {
@@ -221,7 +221,7 @@ DynamicRegions DynamicRegions::Build(const std::vector<Instance>& instances, con
   DynamicRegions out;
   out.image_size_ = image_size;
   for (const Instance& instance : instances) {
-    if (!UsesInstance(instance, options)) continue;
+    if (!options.Uses(instance)) continue;
     ++out.instances_used_;
     out.regions_.push_back(BuildRegion(instance, depth_m, image_size, options));
   }

@@ -47,6 +47,8 @@ struct DynamicFilterOptions {
 
   bool Check(std::string* error) const;
   bool IsDynamicClass(const std::string& class_name) const;
+  // Whether the filter acts on the instance: a dynamic class, scored at least min_score.
+  bool Uses(const Instance& instance) const;
 };
 
 struct DynamicFilterStats {

@@ -12,6 +12,21 @@ cv::Mat DilateEllipse(const cv::Mat& src, int radius) {
   DETSLAM_CHECK(src.type() == CV_8UC1);
   DETSLAM_CHECK(radius >= 0);
   if (radius == 0 || src.empty()) return src.clone();
+  // Only the non-zero pixels' bounding box grown by the radius can change: dilate that window
+  // alone (a person is a fraction of the image). Pixels beyond the window are zero in `src` and
+  // stay zero, and those beyond the image count for nothing in both.
+  const cv::Rect image(0, 0, src.cols, src.rows);
+  const cv::Rect nonzero = cv::boundingRect(src);
+  if (nonzero.empty()) return cv::Mat::zeros(src.size(), CV_8UC1);
+  const cv::Rect window =
+      cv::Rect(nonzero.x - radius, nonzero.y - radius, nonzero.width + 2 * radius,
+               nonzero.height + 2 * radius) &
+      image;
+  if (window != image) {
+    cv::Mat out = cv::Mat::zeros(src.size(), CV_8UC1);
+    DilateEllipse(src(window), radius).copyTo(out(window));
+    return out;
+  }
   const int size = 2 * radius + 1;
   const cv::Mat kernel = cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(size, size));
   const auto opencv_dilate = [&] {

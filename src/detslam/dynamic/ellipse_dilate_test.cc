@@ -43,6 +43,27 @@ TEST(DilateEllipse, EqualsOpenCvDilateWithTheEllipticKernel) {
   }
 }
 
+// Only the window around the non-zero pixels is dilated: a person-sized blob far from the borders,
+// one touching a corner, single pixels, an empty mask.
+TEST(DilateEllipse, EqualsOpenCvDilateWhereOnlyPartOfTheImageIsSet) {
+  const cv::Size size(640, 480);
+  cv::Mat centre = cv::Mat::zeros(size, CV_8UC1);
+  cv::ellipse(centre, {320, 260}, {60, 150}, 0, 0, 360, cv::Scalar(255), cv::FILLED);
+  cv::Mat corner = cv::Mat::zeros(size, CV_8UC1);
+  cv::rectangle(corner, {600, 0}, {639, 30}, cv::Scalar(255), cv::FILLED);
+  cv::Mat pixels = cv::Mat::zeros(size, CV_8UC1);
+  pixels.at<uint8_t>(3, 200) = 7;
+  pixels.at<uint8_t>(300, 5) = 255;
+  const cv::Mat empty = cv::Mat::zeros(size, CV_8UC1);
+  for (const cv::Mat& src : {centre, corner, pixels, empty}) {
+    for (int radius : {3, 10, 15, 24, 40}) {
+      const cv::Mat fast = DilateEllipse(src, radius);
+      ASSERT_EQ(fast.size(), size);
+      EXPECT_EQ(cv::norm(fast, Reference(src, radius), cv::NORM_INF), 0.0) << "radius " << radius;
+    }
+  }
+}
+
 TEST(DilateEllipse, RejectsOtherTypesAndNegativeRadii) {
   EXPECT_DEATH(DilateEllipse(cv::Mat::zeros(4, 4, CV_32FC1), 2), "");
   EXPECT_DEATH(DilateEllipse(cv::Mat::zeros(4, 4, CV_8UC1), -1), "");

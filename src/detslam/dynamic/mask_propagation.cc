@@ -38,11 +38,21 @@ MaskPropagator::MaskPropagator(MaskPropagationOptions options) : options_(option
   DETSLAM_CHECK_MSG(options_.Check(&error), "invalid MaskPropagationOptions: " << error);
 }
 
+int NearestShift(double d) {
+  // warpAffine's nearest neighbour: source x = (round(-d * 2^10) + x * 2^10 + 2^9) >> 10.
+  constexpr int kBits = 10;
+  return -((cvRound(-d * (1 << kBits)) + (1 << (kBits - 1))) >> kBits);
+}
+
 cv::Mat ShiftMask(const cv::Mat& mask, double dx, double dy) {
   if (mask.empty()) return mask;
-  const cv::Mat m = (cv::Mat_<double>(2, 3) << 1, 0, dx, 0, 1, dy);
-  cv::Mat out;
-  cv::warpAffine(mask, out, m, mask.size(), cv::INTER_NEAREST, cv::BORDER_CONSTANT, 0);
+  // A whole-pixel copy: the shift cv::warpAffine(INTER_NEAREST) makes of a translation, without
+  // its per-pixel coordinate arithmetic over the whole image.
+  const int sx = NearestShift(dx), sy = NearestShift(dy);
+  cv::Mat out = cv::Mat::zeros(mask.size(), mask.type());
+  const cv::Rect image(0, 0, mask.cols, mask.rows);
+  const cv::Rect to = cv::Rect(sx, sy, mask.cols, mask.rows) & image;
+  if (!to.empty()) mask(to - cv::Point(sx, sy)).copyTo(out(to));
   return out;
 }
 

@@ -42,7 +42,12 @@ class MaskPropagator {
   int age_ = 0;
 };
 
-// Shifts a CV_8UC1 mask by (dx, dy) pixels (zeros enter at the borders).
+// The whole-pixel shift cv::warpAffine with INTER_NEAREST makes of a translation by `d` pixels:
+// the nearest integer, halves rounded down (its 10-bit fixed point).
+int NearestShift(double d);
+
+// Shifts a CV_8UC1 mask by (dx, dy) pixels (zeros enter at the borders): NearestShift of each,
+// equal to cv::warpAffine(INTER_NEAREST) of the translation pixel for pixel.
 cv::Mat ShiftMask(const cv::Mat& mask, double dx, double dy);
 
 }  // namespace detslam

@@ -168,6 +168,28 @@ TEST(MaskPropagation, ShiftMaskMovesPixelsAndClearsTheBorder) {
   EXPECT_EQ(cv::countNonZero(ShiftMask(m, 20, 0)), 0);
 }
 
+// The whole-pixel copy equals the translation by cv::warpAffine(INTER_NEAREST) it replaced, for
+// fractional shifts (halves included), shifts off the image and a non-binary mask.
+TEST(MaskPropagation, ShiftMaskEqualsWarpAffineNearest) {
+  cv::Mat m(48, 64, CV_8UC1);
+  cv::RNG(5).fill(m, cv::RNG::UNIFORM, 0, 256);
+  cv::RNG rng(11);
+  std::vector<double> shifts = {0, 0.5, -0.5, 1.5, -1.5, 2.4999, -2.5001, 63.6, -70, 12.49951};
+  for (int i = 0; i < 40; ++i) shifts.push_back(rng.uniform(-30.0, 30.0));
+  for (double dx : shifts) {
+    for (double dy : {0.5, -3.7, 0.0, 10.25, -0.5}) {
+      cv::Mat reference;
+      const cv::Mat t = (cv::Mat_<double>(2, 3) << 1, 0, dx, 0, 1, dy);
+      cv::warpAffine(m, reference, t, m.size(), cv::INTER_NEAREST, cv::BORDER_CONSTANT, 0);
+      EXPECT_EQ(cv::norm(ShiftMask(m, dx, dy), reference, cv::NORM_INF), 0.0)
+          << "dx " << dx << " dy " << dy;
+    }
+  }
+  EXPECT_EQ(NearestShift(0.5), 0);
+  EXPECT_EQ(NearestShift(-0.5), -1);
+  EXPECT_EQ(NearestShift(2.6), 3);
+}
+
 TEST(MaskPropagation, RejectsInvalidOptions) {
   MaskPropagationOptions o;
   o.max_corners = 0;

@@ -107,7 +107,7 @@ std::vector<Binding> MakeBindings() {
   k.push_back(Key("Place.Vocabulary", "bag-of-words vocabulary file for relocalisation and loop detection (empty: the shipped one; none: no place recognition) (--vocabulary)", [](auto& r) -> auto& { return r.run.slam.vocabulary; }));
   k.push_back(Key("LoopClosing.GlobalBAIterations", 0, kInf, "global bundle adjustment iterations after a loop (0: none)", [](auto& r) -> auto& { return r.run.slam.loop.global_ba_iterations; }));
   // Det-SLAM dynamic filter.
-  k.push_back(Key("Dynamic.Classes", "class names treated as dynamic (comma-separated); when set, the segmenter also returns only these (else all classes)", [](auto& r) -> auto& { return r.run.slam.dynamic.filter.dynamic_classes; })
+  k.push_back(Key("Dynamic.Classes", "class names treated as dynamic (comma-separated); the segmenter returns only these", [](auto& r) -> auto& { return r.run.slam.dynamic.filter.dynamic_classes; })
                   .Also([](auto& r) -> auto& { return r.segmenter.dnn.classes; })
                   .Also([](auto& r) -> auto& { return r.segmenter.maskrcnn.classes; }));
   k.push_back(Key("Dynamic.Alpha", 0, kInf, "depth-step widening factor alpha of the depth interval", [](auto& r) -> auto& { return r.run.slam.dynamic.filter.alpha; }));

@@ -63,7 +63,9 @@ TEST(SettingsKeysTest, EveryKeyIsDeclaredOnceWithTheOptionsStructDefault) {
   EXPECT_EQ(r.run.slam.dynamic.filter.dynamic_classes, slam.dynamic.filter.dynamic_classes);
   EXPECT_EQ(r.run.slam.tracker.keyframe_far_points, slam.tracker.keyframe_far_points);
   EXPECT_EQ(r.run.slam.dynamic.segment_every, DetSlamOptions().segment_every);
-  EXPECT_TRUE(r.segmenter.dnn.classes.empty());  // the segmenter returns all classes by default
+  // The segmenters return the dynamic classes only, by default too.
+  EXPECT_EQ(r.segmenter.dnn.classes, slam.dynamic.filter.dynamic_classes);
+  EXPECT_EQ(r.segmenter.maskrcnn.classes, slam.dynamic.filter.dynamic_classes);
   EXPECT_FLOAT_EQ(r.segmenter.maskrcnn.score_threshold, MaskRcnnOptions().score_threshold);
   const std::vector<std::pair<std::string, SettingValue>> values = SettingValues(r);
   ASSERT_EQ(values.size(), DeclaredSettings().size());

@@ -30,8 +30,8 @@ struct SegmenterInput {
 class Segmenter {
  public:
   virtual ~Segmenter() = default;
-  // Instances found in the frame (all classes the backend knows; the dynamic filter decides which
-  // classes count as dynamic). Throws InputError for unreadable inputs named in the message.
+  // Instances found in the frame (the classes the backend returns; the Det-SLAM stage keeps those
+  // the dynamic filter uses). Throws InputError for unreadable inputs named in the message.
   virtual std::vector<Instance> Segment(const SegmenterInput& input) = 0;
   virtual std::string name() const = 0;
   // Runs the backend once on `input` and forgets the result and any state it left (e.g. a network

@@ -82,7 +82,7 @@ TEST(DnnOptions, FromSettingsResolvesCompanionsAndClasses) {
   EXPECT_EQ(d.names_path, "/m/yolox_nano/coco.names");
   EXPECT_EQ(d.person_mask_model, "/m/selfie_segmentation/selfie_segmentation.onnx");
   EXPECT_TRUE(d.weights_path.empty());
-  EXPECT_TRUE(d.classes.empty());
+  EXPECT_EQ(d.classes, std::vector<std::string>{"person"});  // Dynamic.Classes' default
   std::string error;
   EXPECT_TRUE(d.Check(&error)) << error;
 }

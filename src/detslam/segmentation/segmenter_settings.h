@@ -26,6 +26,11 @@ struct SegmenterSettings {
   std::string maskrcnn_names = "mask_rcnn_inception_v2_coco/object_detection_classes_coco.txt";
   DnnSegmenterOptions dnn;   // thresholds, sizes, classes (its paths are filled from the above)
   MaskRcnnOptions maskrcnn;  // score threshold, classes (its paths are filled from the above)
+
+  // The segmenters return only the dynamic classes: Dynamic.Classes sets them with the filter's,
+  // and its default (DynamicFilterOptions::dynamic_classes) is theirs too. Masks of the other
+  // classes would be computed for nothing.
+  SegmenterSettings() { dnn.classes = maskrcnn.classes = {"person"}; }
 };
 
 }  // namespace detslam
