@@ -41,9 +41,11 @@ def commit() -> str:
         status = subprocess.run(["git", "status", "--porcelain", "--untracked-files=no"],
                                 capture_output=True, text=True, check=True,
                                 cwd=os.path.dirname(os.path.abspath(__file__))).stdout
-        # The benchmark file and the README summary do not make the measured code dirty.
+        # The benchmark file, the README summary and the plots the benchmarks draw (docs/*.svg)
+        # do not make the measured code dirty.
         dirty = [l for l in status.splitlines()
-                 if l.strip() and not l.endswith(DOCS_AND_README)]
+                 if l.strip() and not l.endswith(DOCS_AND_README)
+                 and not (l[3:].startswith("docs/") and l.endswith(".svg"))]
         return out.stdout.strip() + (" (uncommitted changes)" if dirty else "")
     except (OSError, subprocess.CalledProcessError):
         return "unknown"
