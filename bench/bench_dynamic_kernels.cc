@@ -7,9 +7,9 @@
 #include <opencv2/core/utility.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "detslam/core/allocator.h"
 #include "detslam/dynamic/ellipse_dilate.h"
 #include "detslam/dynamic/mask_carrier.h"
+#include "kernel_bench_main.h"
 
 namespace {
 
@@ -98,13 +98,4 @@ BENCHMARK(BM_MaskCarry)->Arg(1)->Arg(3)->Arg(6)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 
-// Freed frame-sized buffers stay for the next iteration, as in the pipeline's steady state
-// (detslam/core/allocator.h).
-int main(int argc, char** argv) {
-  detslam::KeepFreedMemoryForReuse();
-  benchmark::Initialize(&argc, argv);
-  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
-  benchmark::RunSpecifiedBenchmarks();
-  benchmark::Shutdown();
-  return 0;
-}
+int main(int argc, char** argv) { return detslam::bench::RunKernelBenchmarks(argc, argv); }

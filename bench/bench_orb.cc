@@ -10,9 +10,9 @@
 #include <string>
 #include <vector>
 
-#include "detslam/core/allocator.h"
 #include "detslam/features/matcher.h"
 #include "detslam/features/orb_extractor.h"
+#include "kernel_bench_main.h"
 
 namespace {
 
@@ -68,13 +68,4 @@ BENCHMARK(BM_MatchBruteForce)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 
-// Freed frame-sized buffers stay for the next iteration, as in the pipeline's steady state
-// (detslam/core/allocator.h).
-int main(int argc, char** argv) {
-  detslam::KeepFreedMemoryForReuse();
-  benchmark::Initialize(&argc, argv);
-  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
-  benchmark::RunSpecifiedBenchmarks();
-  benchmark::Shutdown();
-  return 0;
-}
+int main(int argc, char** argv) { return detslam::bench::RunKernelBenchmarks(argc, argv); }
