@@ -31,7 +31,7 @@
 namespace detslam {
 
 struct DynamicFilterOptions {
-  std::vector<std::string> dynamic_classes = {"person"};  // class names treated as dynamic
+  std::vector<std::string> dynamic_classes = DefaultDynamicClasses();  // treated as dynamic
   float min_score = 0.0f;                                 // ignore instances below this score
   int mask_dilation_px = 15;   // dilate masks by the ORB patch radius: descriptors of corners
                                // closer than that to a person sample the person's pixels

@@ -20,6 +20,10 @@ struct Instance {
   cv::Mat mask;               // CV_8UC1, image size, non-zero = object pixel (may be empty: box only)
 };
 
+// The classes treated as dynamic unless Dynamic.Classes says otherwise: the default of the dynamic
+// filter (DynamicFilterOptions::dynamic_classes) and of the classes the segmenters return.
+inline std::vector<std::string> DefaultDynamicClasses() { return {"person"}; }
+
 struct SegmenterInput {
   int64_t index = 0;          // frame index in the sequence
   Timestamp stamp;            // colour image stamp

@@ -9,6 +9,7 @@
 
 #include "detslam/segmentation/dnn_segmenter.h"
 #include "detslam/segmentation/mask_rcnn_segmenter.h"
+#include "detslam/segmentation/segmenter.h"
 
 namespace detslam {
 
@@ -28,9 +29,8 @@ struct SegmenterSettings {
   MaskRcnnOptions maskrcnn;  // score threshold, classes (its paths are filled from the above)
 
   // The segmenters return only the dynamic classes: Dynamic.Classes sets them with the filter's,
-  // and its default (DynamicFilterOptions::dynamic_classes) is theirs too. Masks of the other
-  // classes would be computed for nothing.
-  SegmenterSettings() { dnn.classes = maskrcnn.classes = {"person"}; }
+  // and its default is theirs too. Masks of the other classes would be computed for nothing.
+  SegmenterSettings() { dnn.classes = maskrcnn.classes = DefaultDynamicClasses(); }
 };
 
 }  // namespace detslam
