@@ -7,6 +7,7 @@
 #include <opencv2/core.hpp>
 #include <opencv2/core/utility.hpp>
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 #include <string>
 #include <vector>
 
@@ -44,6 +45,33 @@ void BM_OrbExtract(benchmark::State& state) {
   state.counters["keypoints"] = static_cast<double>(keypoints.size());
 }
 BENCHMARK(BM_OrbExtract)->Unit(benchmark::kMillisecond);
+
+// The same with the Det-SLAM stage's ignore mask of two people (about a quarter of the image):
+// cells the mask covers get no low-threshold retry.
+void BM_OrbExtractMasked(benchmark::State& state) {
+  cv::setNumThreads(1);
+  const cv::Mat gray = LoadGray(kFrameA);
+  if (gray.empty()) {
+    state.SkipWithError("shared TUM frame not found (set DETSLAM_SHARED)");
+    return;
+  }
+  cv::Mat mask = cv::Mat::zeros(gray.size(), CV_8UC1);
+  for (int x : {200, 450}) {
+    cv::ellipse(mask, {x, 300}, {80, 180}, 0, 0, 360, cv::Scalar(255), cv::FILLED);
+    cv::circle(mask, {x, 110}, 45, cv::Scalar(255), cv::FILLED);
+  }
+  const detslam::OrbExtractor extractor{detslam::OrbOptions{}};
+  std::vector<cv::KeyPoint> keypoints;
+  cv::Mat descriptors;
+  for (auto _ : state) {
+    extractor.Extract(gray, mask, &keypoints, &descriptors);
+    benchmark::DoNotOptimize(descriptors.data);
+  }
+  state.counters["keypoints"] = static_cast<double>(keypoints.size());
+  state.counters["masked_fraction"] =
+      static_cast<double>(cv::countNonZero(mask)) / static_cast<double>(mask.total());
+}
+BENCHMARK(BM_OrbExtractMasked)->Unit(benchmark::kMillisecond);
 
 void BM_MatchBruteForce(benchmark::State& state) {
   cv::setNumThreads(1);

@@ -99,17 +99,34 @@ void ComputeDescriptor(const cv::Mat& blurred, cv::Point center, float angle_deg
   }
 }
 
+// The level-0 pixel a level coordinate maps to (v = level coordinate * scale, rounded to float as
+// the keypoint test always did), clamped to `size`.
+int LevelZeroPixel(float v, int size) {
+  return std::clamp(static_cast<int>(std::lround(v)), 0, size - 1);
+}
+
 bool Masked(const cv::Mat& mask, float x, float y) {
-  const int c = std::clamp(static_cast<int>(std::lround(x)), 0, mask.cols - 1);
-  const int r = std::clamp(static_cast<int>(std::lround(y)), 0, mask.rows - 1);
-  return mask.at<uint8_t>(r, c) != 0;
+  return mask.at<uint8_t>(LevelZeroPixel(y, mask.rows), LevelZeroPixel(x, mask.cols)) != 0;
+}
+
+// Whether every corner FAST could report at integer level positions [x_begin, x_end) x [y_begin,
+// y_end) would be dropped by Masked: the level-0 pixels they map to (a monotone map) are all set.
+bool CellFullyMasked(const cv::Mat& mask, double scale, int x_begin, int x_end, int y_begin,
+                     int y_end) {
+  const auto pixel = [scale](int v, int size) {
+    return LevelZeroPixel(static_cast<float>(v * scale), size);
+  };
+  const int x0 = pixel(x_begin, mask.cols), x1 = pixel(x_end - 1, mask.cols);
+  const int y0 = pixel(y_begin, mask.rows), y1 = pixel(y_end - 1, mask.rows);
+  const cv::Rect area(x0, y0, x1 - x0 + 1, y1 - y0 + 1);
+  return cv::countNonZero(mask(area)) == area.area();
 }
 
 // FAST corners (with non-max suppression) of one level inside [kDetectBorder, size -
 // kDetectBorder), by cells of about kCellSize pixels: the whole area at ini_th_fast first, then, in
-// each cell that has no (unmasked) corner, that cell again at min_th_fast. Corners whose level-0
-// position is masked are dropped before the per-cell decision. Positions are level pixel
-// coordinates.
+// each cell that has no (unmasked) corner, that cell again at min_th_fast (not if the mask covers
+// the whole cell: nothing found there could be kept). Corners whose level-0 position is masked are
+// dropped before the per-cell decision. Positions are level pixel coordinates.
 void DetectCorners(const cv::Mat& level_image, double scale, const cv::Mat& ignore_mask,
                    const OrbOptions& options, std::vector<cv::KeyPoint>* corners) {
   corners->clear();
@@ -148,6 +165,11 @@ void DetectCorners(const cv::Mat& level_image, double scale, const cv::Mat& igno
       const int x_end = kDetectBorder + static_cast<int>(std::lround((cx + 1) * cell_w));
       const int y_begin = kDetectBorder + static_cast<int>(std::lround(cy * cell_h));
       const int y_end = kDetectBorder + static_cast<int>(std::lround((cy + 1) * cell_h));
+      // A cell under the mask would only yield corners that are dropped: skip its FAST run.
+      if (options.skip_masked_cells && !ignore_mask.empty() &&
+          CellFullyMasked(ignore_mask, scale, x_begin, x_end, y_begin, y_end)) {
+        continue;
+      }
       const cv::Rect roi(x_begin - kFastRadius, y_begin - kFastRadius,
                          x_end - x_begin + 2 * kFastRadius, y_end - y_begin + 2 * kFastRadius);
       found.clear();

@@ -186,6 +186,44 @@ double AngleError(double a, double b) {
   return std::min(d, 360.0 - d);
 }
 
+// Skipping the low-threshold retry in cells the mask covers is only a speed-up: on masks of
+// several shapes (blobs, a frame border, a mask of everything but thin strips, single holes)
+// the keypoints and descriptors are exactly those of the extraction that retries every cell.
+TEST(OrbExtractorTest, SkippingMaskedCellsDoesNotChangeTheResult) {
+  const cv::Mat image = MakeTexture(640, 480, 11);
+  std::vector<cv::Mat> masks;
+  cv::Mat blobs(480, 640, CV_8UC1, cv::Scalar(0));
+  cv::ellipse(blobs, {200, 260}, {90, 200}, 0, 0, 360, cv::Scalar(255), cv::FILLED);
+  cv::circle(blobs, {520, 120}, 70, cv::Scalar(7), cv::FILLED);
+  masks.push_back(blobs);
+  cv::Mat border(480, 640, CV_8UC1, cv::Scalar(255));
+  border(cv::Rect(100, 80, 400, 300)).setTo(0);
+  masks.push_back(border);
+  cv::Mat strips(480, 640, CV_8UC1, cv::Scalar(255));
+  for (int x = 13; x < 640; x += 97) strips.col(x).setTo(0);  // one clear column every 97 px
+  masks.push_back(strips);
+  cv::Mat holes(480, 640, CV_8UC1, cv::Scalar(255));
+  for (int y = 5; y < 480; y += 41) {
+    for (int x = 3; x < 640; x += 53) holes.at<uint8_t>(y, x) = 0;  // single clear pixels
+  }
+  masks.push_back(holes);
+  OrbOptions retry_all;
+  retry_all.skip_masked_cells = false;
+  for (size_t m = 0; m < masks.size(); ++m) {
+    const Extraction fast = Extract(image, masks[m]);
+    const Extraction reference = Extract(image, masks[m], retry_all);
+    ASSERT_EQ(fast.keypoints.size(), reference.keypoints.size()) << "mask " << m;
+    for (size_t i = 0; i < fast.keypoints.size(); ++i) {
+      EXPECT_EQ(fast.keypoints[i].pt, reference.keypoints[i].pt) << "mask " << m << " kp " << i;
+      EXPECT_EQ(fast.keypoints[i].octave, reference.keypoints[i].octave);
+      EXPECT_EQ(fast.keypoints[i].angle, reference.keypoints[i].angle);
+    }
+    EXPECT_EQ(cv::norm(fast.descriptors, reference.descriptors, cv::NORM_HAMMING), 0.0)
+        << "mask " << m;
+  }
+  EXPECT_GT(Extract(image, masks[0]).keypoints.size(), 500u);  // the test extracts something
+}
+
 TEST(OrbExtractorTest, RotatingImageRotatesKeypointAngles) {
   const cv::Mat image = MakeTexture(640, 480, 4);
   for (double theta : {25.0, -70.0, 150.0}) {
