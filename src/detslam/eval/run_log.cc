@@ -76,6 +76,10 @@ RunLog ReadRunLog(const std::string& path) {
     r.realtime.latency_median_ms = Get<double>(latency, "median", path, "realtime.latency_ms: ");
     r.realtime.latency_p99_ms = Get<double>(latency, "p99", path, "realtime.latency_ms: ");
     r.realtime.latency_max_ms = Get<double>(latency, "max", path, "realtime.latency_ms: ");
+    if (t.contains("keyframes_mapped_in_burst")) {
+      r.realtime.keyframes_mapped_in_burst =
+          Get<int64_t>(t, "keyframes_mapped_in_burst", path, "realtime: ");
+    }
     if (t.contains("asynchronous_segmentation")) {
       r.realtime.asynchronous = Get<bool>(t, "asynchronous_segmentation", path, "realtime: ");
     }

@@ -47,6 +47,8 @@ struct RunRealtimeLog {
   int64_t frames_segmented = 0, keyframes_deferred = 0;
   int64_t keyframes_stale_masks = 0;  // made with stale masks after waiting for fresh ones
   double mask_age_median = 0, mask_age_max = 0;  // input frames
+  // Keyframes mapped without fusion / BA because more were waiting (absent in older files: -1).
+  int64_t keyframes_mapped_in_burst = -1;
 };
 
 struct RunLog {

@@ -138,6 +138,7 @@ TEST_F(RunLogTest, ReadsTheCameraRateBlockOfRealtimeRuns) {
   EXPECT_DOUBLE_EQ(r.realtime.latency_p99_ms, 270.25);
   EXPECT_DOUBLE_EQ(r.realtime.latency_max_ms, 300.0);
   EXPECT_FALSE(r.realtime.asynchronous);  // a file without the key (written before it existed)
+  EXPECT_EQ(r.realtime.keyframes_mapped_in_burst, -1);  // idem
   text.replace(text.find("\"p99\": 270.25"), 13, "\"p99\": null");
   EXPECT_THAT(Error(Write(text)), HasSubstr("realtime.latency_ms: key 'p99' has the wrong type"));
 }
@@ -149,9 +150,10 @@ TEST_F(RunLogTest, ReadsTheAsynchronousSegmentationCounters) {
                "latency_ms": {"median": 40, "mean": 42, "p99": 80, "max": 90},
                "asynchronous_segmentation": true, "frames_segmented": 95,
                "mask_age_frames": {"median": 4, "mean": 4.2, "max": 11}, "keyframes_deferred": 7,
-               "keyframes_stale_masks": 2}, )");
+               "keyframes_stale_masks": 2, "keyframes_mapped_in_burst": 5}, )");
   const RunLog r = ReadRunLog(Write(text));
   EXPECT_TRUE(r.realtime.asynchronous);
+  EXPECT_EQ(r.realtime.keyframes_mapped_in_burst, 5);
   EXPECT_EQ(r.realtime.frames_segmented, 95);
   EXPECT_EQ(r.realtime.keyframes_deferred, 7);
   EXPECT_EQ(r.realtime.keyframes_stale_masks, 2);

@@ -281,7 +281,12 @@ std::string RenderHtmlReport(const RunLog& run, const EvalResult* eval) {
                        " frames/s processed; latency from arrival to pose: median " +
                        Fixed(t.latency_median_ms, 1) + " ms, 99th percentile " +
                        Fixed(t.latency_p99_ms, 1) + " ms, max " + Fixed(t.latency_max_ms, 1) +
-                       " ms");
+                       " ms" +
+                       (t.keyframes_mapped_in_burst >= 0
+                            ? "; " + std::to_string(t.keyframes_mapped_in_burst) +
+                                  " keyframes mapped without fusion or bundle adjustment while "
+                                  "more waited"
+                            : std::string()));
     if (t.asynchronous) {
       os << TableRow("asynchronous segmentation",
                      std::to_string(t.frames_segmented) +

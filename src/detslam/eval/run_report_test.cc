@@ -124,6 +124,10 @@ TEST(RunReport, ACameraRateRunShowsItsDropsAndLatency) {
   EXPECT_THAT(html, HasSubstr("60 frames offered, 40 dropped (66.7 %)"));
   EXPECT_THAT(html, HasSubstr("median 150.0 ms, 99th percentile 270.5 ms, max 300.0 ms"));
   EXPECT_THAT(html, Not(HasSubstr("asynchronous segmentation")));
+  EXPECT_THAT(html, Not(HasSubstr("while more waited")));  // an older file without the count
+  log.realtime.keyframes_mapped_in_burst = 6;
+  EXPECT_THAT(RenderHtmlReport(log, nullptr),
+              HasSubstr("6 keyframes mapped without fusion or bundle adjustment while more waited"));
   log.realtime.asynchronous = true;
   log.realtime.frames_segmented = 18;
   log.realtime.mask_age_median = 4;

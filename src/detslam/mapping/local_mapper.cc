@@ -33,7 +33,11 @@ LocalMapper::LocalMapper(const PinholeCamera& camera, LocalMapperOptions options
   DETSLAM_CHECK_MSG(options_.Check(&error), error);
 }
 
-LocalMappingSummary LocalMapper::ProcessKeyFrame(KeyFrameId current, MapStore* store) {
+LocalMappingSummary LocalMapper::ProcessKeyFrame(KeyFrameId current, MapStore* store,
+                                                 const LocalMappingControl& control) {
+  const auto waiting = [&control] {
+    return control.keyframes_waiting && control.keyframes_waiting();
+  };
   LocalMappingSummary summary;
   bool bundle_adjust = false;
   {
@@ -54,13 +58,22 @@ LocalMappingSummary LocalMapper::ProcessKeyFrame(KeyFrameId current, MapStore* s
     CullLandmarks(map, current, &summary);
   }
   if (options_.triangulate) TriangulateNewLandmarks(store, current, &summary);
+  // With more keyframes waiting, fusion and then BA and culling are left to a later keyframe.
+  const bool fuse = !waiting();
   {
     const MapStore::WriteAccess access = store->Write();
     Map& map = *access;
-    if (options_.fuse && map.HasKeyFrame(current)) FuseWithNeighbours(map, current, &summary);
+    if (fuse && options_.fuse && map.HasKeyFrame(current)) {
+      FuseWithNeighbours(map, current, &summary);
+    }
     bundle_adjust = options_.local_ba && map.NumKeyFrames() > 2;
   }
-  if (bundle_adjust) LocalBundleAdjustment(store, current, &summary);
+  if (!fuse) summary.skipped_for_waiting = true;
+  if (waiting()) {
+    summary.skipped_for_waiting = true;
+    return summary;
+  }
+  if (bundle_adjust) LocalBundleAdjustment(store, current, control.abort_ba, &summary);
   if (options_.cull_keyframes) CullKeyFrames(*store->Write(), current, &summary);
   return summary;
 }
@@ -124,6 +137,7 @@ void LocalMapper::FuseWithNeighbours(Map& map, KeyFrameId current, LocalMappingS
 }
 
 void LocalMapper::LocalBundleAdjustment(MapStore* store, KeyFrameId current,
+                                        const std::atomic<bool>* abort_ba,
                                         LocalMappingSummary* summary) {
   const auto t0 = std::chrono::steady_clock::now();
   // Snapshot: the current keyframe and its best covisibles are optimised; the keyframes that
@@ -163,7 +177,7 @@ void LocalMapper::LocalBundleAdjustment(MapStore* store, KeyFrameId current,
   auto solve = [&](MapBundle& bundle) {
     BundleOptions bo;
     bo.max_iterations = options_.ba_iterations;
-    return SolveBundle(camera_, &bundle.problem, bo);
+    return SolveBundle(camera_, &bundle.problem, bo, abort_ba);
   };
   auto apply = [&](Map& map, const MapBundle& bundle, const BundleSummary& s) {
     if (!s.usable) return;

@@ -4,7 +4,9 @@
 // redundant-keyframe culling.
 #pragma once
 
+#include <atomic>
 #include <deque>
+#include <functional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -45,25 +47,37 @@ struct LocalMappingSummary {
   int culled_landmarks = 0;
   int ba_outliers = 0;
   double ba_ms = 0.0;
+  bool skipped_for_waiting = false;  // keyframes waited: no fusion, BA or keyframe culling
   std::vector<ErasedKeyFrame> erased_keyframes;
+};
+
+// How a threaded run lets local mapping keep up with the tracker (ORB-SLAM3's LocalMapping):
+// while more keyframes wait, a keyframe gets no fusion, bundle adjustment or keyframe culling
+// (the last of a burst gets them, over the neighbourhood of all), and a bundle adjustment stops
+// after its current iteration when the tracker asks (InterruptBA). Sequential runs leave both off.
+struct LocalMappingControl {
+  std::function<bool()> keyframes_waiting;  // null: never
+  const std::atomic<bool>* abort_ba = nullptr;
 };
 
 class LocalMapper {
  public:
   LocalMapper(const PinholeCamera& camera, LocalMapperOptions options);
 
-  // Processes a keyframe just inserted by the tracker. Deterministic. Every step holds the
-  // store's write access except the triangulation's descriptor matching (one neighbour at a time)
-  // and the bundle-adjustment solve (on a snapshot, MapStore::ComputeOutsideLock), which run
-  // while the tracker may use the map.
-  LocalMappingSummary ProcessKeyFrame(KeyFrameId kf, MapStore* store);
+  // Processes a keyframe just inserted by the tracker. Deterministic (with the default control).
+  // Every step holds the store's write access except the triangulation's descriptor matching (one
+  // neighbour at a time) and the bundle-adjustment solve (on a snapshot,
+  // MapStore::ComputeOutsideLock), which run while the tracker may use the map.
+  LocalMappingSummary ProcessKeyFrame(KeyFrameId kf, MapStore* store,
+                                      const LocalMappingControl& control = {});
 
  private:
   void CullLandmarks(Map& map, KeyFrameId current, LocalMappingSummary* summary);
   void TriangulateNewLandmarks(MapStore* store, KeyFrameId current,
                                LocalMappingSummary* summary);  // triangulate.cc
   void FuseWithNeighbours(Map& map, KeyFrameId current, LocalMappingSummary* summary);
-  void LocalBundleAdjustment(MapStore* store, KeyFrameId current, LocalMappingSummary* summary);
+  void LocalBundleAdjustment(MapStore* store, KeyFrameId current,
+                             const std::atomic<bool>* abort_ba, LocalMappingSummary* summary);
   void CullKeyFrames(Map& map, KeyFrameId current, LocalMappingSummary* summary);
 
   PinholeCamera camera_;

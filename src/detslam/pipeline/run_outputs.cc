@@ -230,7 +230,8 @@ void WriteRunOutputs(const RgbdSource& dataset, const Settings& settings, const 
           {"mean", summary.latency.mean},
           {"p99", summary.latency_p99_ms},
           {"max", summary.latency.max}}},
-        {"asynchronous_segmentation", summary.async_segmentation}};
+        {"asynchronous_segmentation", summary.async_segmentation},
+        {"keyframes_mapped_in_burst", summary.keyframes_mapped_in_burst}};
     if (summary.async_segmentation) {
       j["realtime"]["frames_segmented"] = summary.frames_segmented;
       j["realtime"]["mask_age_frames"] = {{"median", summary.mask_age.median},

@@ -207,6 +207,7 @@ class RunRecorder {
     summary_.loop_detection = slam.loop_detection_stats();
     summary_.global_ba_runs = slam.global_ba_runs();
     summary_.global_ba_stopped = slam.global_ba_stopped();
+    summary_.keyframes_mapped_in_burst = slam.keyframes_mapped_in_burst();
     summary_.global_ba_applied_after_frames = slam.global_ba_applied_after_frames();
     {
       const MapStore::ReadAccess map = slam.ReadMap();

@@ -110,6 +110,7 @@ struct RunSummary {
   ErrorStats mask_age;
   size_t keyframes_deferred = 0;
   size_t keyframes_stale_masks = 0;  // made with stale masks after waiting (FrameReport)
+  int keyframes_mapped_in_burst = 0;  // SlamSystem::keyframes_mapped_in_burst
   size_t keyframe_masks = 0;  // written to out_dir/keyframe_masks
   DenseMapStats dense;        // of the dense map (dense_map)
   double wall_s = 0;

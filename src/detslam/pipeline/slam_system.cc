@@ -86,7 +86,12 @@ std::vector<LoopRecord> SlamSystem::loops() const {
 
 void SlamSystem::MapKeyFrame(KeyFrameId kf, FrameReport* report) {
   const auto t0 = std::chrono::steady_clock::now();
-  const LocalMappingSummary s = mapper_.ProcessKeyFrame(kf, &store_);
+  abort_local_ba_ = false;  // a request from before this keyframe was for the previous one
+  LocalMappingControl control;
+  control.keyframes_waiting = [this] { return keyframes_to_map_ > 1; };
+  control.abort_ba = &abort_local_ba_;
+  const LocalMappingSummary s = mapper_.ProcessKeyFrame(kf, &store_, control);
+  if (s.skipped_for_waiting) ++keyframes_mapped_in_burst_;
   bool global_ba = false;
   {
     const MapStore::WriteAccess map = store_.Write();
@@ -164,6 +169,7 @@ void SlamSystem::MapKeyFrame(KeyFrameId kf, FrameReport* report) {
   }
   report->timings.mapping_ms = MsSince(t0);
   mapping_times_ms_.push_back(report->timings.mapping_ms);
+  --keyframes_to_map_;
 }
 
 std::vector<double> SlamSystem::mapping_times_ms() const {
@@ -290,7 +296,12 @@ KeyFrameId SlamSystem::TrackFrame(Frame frame, FrameReport* report, Frame* track
   Map& map = *access;
   const size_t kfs_before = map.NumKeyFrames();
   last_tracked_frame_ = report->index;
-  report->tracking = tracker_.Track(map, &frame);
+  LocalMappingState mapping;  // idle in sequential runs: each keyframe is mapped before the next frame
+  const int to_map = keyframes_to_map_;
+  mapping.idle = to_map == 0;
+  mapping.queued = std::max(0, to_map - 1);
+  report->tracking = tracker_.Track(map, &frame, mapping);
+  if (report->tracking.interrupt_local_ba) abort_local_ba_ = true;
   KeyFrameId new_kf = kNoKeyFrame;
   if (report->tracking.pose_valid && report->tracking.need_keyframe && !options_.localization) {
     // Asynchronous segmentation: no new map points from masks carried over too many frames,
@@ -311,6 +322,7 @@ KeyFrameId SlamSystem::TrackFrame(Frame frame, FrameReport* report, Frame* track
     new_kf = tracker_.reference_keyframe();  // a new map's first keyframe
     keyframe_wait_since_ = -1;
   }
+  if (new_kf != kNoKeyFrame) ++keyframes_to_map_;
   report->timings.tracking_ms = MsSince(t0);
 
   if (report->tracking.pose_valid) {

@@ -191,6 +191,9 @@ class SlamSystem {
   // while they ran (their solution is discarded: it predates that loop's correction).
   int global_ba_runs() const;
   int global_ba_stopped() const;
+  // Threaded runs: keyframes local mapping processed without fusion, BA or keyframe culling
+  // because more keyframes were waiting (a burst); 0 in sequential runs.
+  int keyframes_mapped_in_burst() const { return keyframes_mapped_in_burst_; }
   // For each global BA whose solution was applied to the map: the newest input frame tracked by
   // then.
   std::vector<int64_t> global_ba_applied_after_frames() const;
@@ -241,6 +244,11 @@ class SlamSystem {
   std::atomic<bool> interrupted_{false};        // Interrupt(): no new global BA
   std::atomic<int> global_ba_runs_{0};
   std::atomic<int> global_ba_stopped_{0};
+  // Keyframes TrackFrame made that MapKeyFrame has not finished (0 before every frame of a
+  // sequential run), and the tracker's request to cut the running local BA short.
+  std::atomic<int> keyframes_to_map_{0};
+  std::atomic<bool> abort_local_ba_{false};
+  std::atomic<int> keyframes_mapped_in_burst_{0};  // mapped without fusion / BA (keyframes waited)
 };
 
 ScaleInfo MakeScaleInfo(const OrbExtractor& extractor);

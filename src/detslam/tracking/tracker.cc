@@ -89,7 +89,7 @@ KeyFrameId Tracker::RelocalizeFrame(const Map& map, Frame* frame) {
   return Relocalize(map, frame) ? reference_kf_ : kNoKeyFrame;
 }
 
-TrackingResult Tracker::Track(Map& map, Frame* frame) {
+TrackingResult Tracker::Track(Map& map, Frame* frame, const LocalMappingState& mapping) {
   TrackingResult result;
   PrepareFrame(frame);
 
@@ -156,7 +156,8 @@ TrackingResult Tracker::Track(Map& map, Frame* frame) {
     state_ = TrackingState::kOk;
     result.pose_valid = true;
     result.num_inliers = inliers;
-    result.need_keyframe = NeedNewKeyFrame(map, *frame, inliers);
+    result.need_keyframe =
+        NeedNewKeyFrame(map, *frame, inliers, mapping, &result.interrupt_local_ba);
     if (last_frame_ && last_frame_->cam_from_world) {
       velocity_ = *frame->cam_from_world * last_frame_->cam_from_world->Inverse();
       velocity_seconds_ = AbsDiffSeconds(frame->stamp, last_frame_->stamp);

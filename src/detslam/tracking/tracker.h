@@ -47,10 +47,21 @@ struct TrackerOptions {
   bool Check(std::string* error) const;
 };
 
+// What the tracker knows of local mapping when it decides on a keyframe (ORB-SLAM3's
+// AcceptKeyFrames and KeyframesInQueue). Sequential runs map each keyframe before the next frame:
+// always idle there.
+struct LocalMappingState {
+  bool idle = true;  // no keyframe is being mapped or waits to be
+  int queued = 0;    // keyframes waiting, not counting the one being mapped
+};
+
 struct TrackingResult {
   TrackingState state = TrackingState::kNotInitialized;
   bool pose_valid = false;  // frame has a pose (state OK this frame)
   bool need_keyframe = false;
+  // The frame wanted a keyframe while local mapping was busy: stop its bundle adjustment, so
+  // that it takes the new keyframes sooner (ORB-SLAM3's InterruptBA). need_keyframe may be false.
+  bool interrupt_local_ba = false;
   bool relocalized = false;
   int num_inliers = 0;         // landmark inliers after local-map tracking
   int geometric_rejected = 0;  // keypoints the geometric check labelled kGeometric
@@ -70,7 +81,9 @@ class Tracker {
 
   // Tracks `frame` (its features must be set). Fills frame->cam_from_world, landmarks, outliers,
   // reference_keyframe. Creates the first keyframe on initialisation.
-  TrackingResult Track(Map& map, Frame* frame);
+  // `mapping`: local mapping's state (threaded runs); while it is busy a keyframe is made only
+  // when tracking needs one (ORB-SLAM3's c1a / c1c) and fewer than kMaxQueuedKeyFrames wait.
+  TrackingResult Track(Map& map, Frame* frame, const LocalMappingState& mapping = {});
 
   // Turns the current frame into a keyframe: links its inlier landmarks, creates landmarks from
   // close depth (ORB-SLAM's CreateNewKeyFrame for RGB-D). Returns its id.
@@ -121,6 +134,7 @@ class Tracker {
       10;  // projection search widening a relocalisation
   static constexpr double kRelocalizationProjectionRatio = 0.9;
   static constexpr int kMinKeyFrameInliers = 15;  // NeedNewKeyFrame c2: at least this many inliers
+  static constexpr int kMaxQueuedKeyFrames = 3;   // ... and, mapping busy, fewer waiting (RGB-D)
   static constexpr double kNewKeyFrameRefRatioOneKf = 0.4;  // thRefRatio with one keyframe
   static constexpr double kNewKeyFrameLowRatio = 0.25;  // c1c: weak tracking against the reference
 
@@ -143,7 +157,9 @@ class Tracker {
   bool TrackReferenceKeyFrame(const Map& map, Frame* frame);
   bool TrackLocalMap(Map& map, Frame* frame, int* inliers);
   bool Relocalize(const Map& map, Frame* frame);
-  bool NeedNewKeyFrame(const Map& map, const Frame& frame, int inliers) const;
+  // Whether the frame should become a keyframe; *interrupt: it wanted one while mapping was busy.
+  bool NeedNewKeyFrame(const Map& map, const Frame& frame, int inliers,
+                       const LocalMappingState& mapping, bool* interrupt) const;
   // Pose optimisation over the frame's matched landmarks and temporary points; marks outliers and
   // drops their associations. Returns the number of inliers.
   int OptimizeFramePose(const Map& map, Frame* frame, bool include_temporary);

@@ -186,7 +186,9 @@ bool Tracker::Relocalize(const Map& map, Frame* frame) {
   return false;
 }
 
-bool Tracker::NeedNewKeyFrame(const Map& map, const Frame& frame, int inliers) const {
+bool Tracker::NeedNewKeyFrame(const Map& map, const Frame& frame, int inliers,
+                              const LocalMappingState& mapping, bool* interrupt) const {
+  *interrupt = false;
   const int num_kfs = static_cast<int>(map.NumKeyFrames());
   const int max_frames = options_.max_frames_between_keyframes;
   if (frame.index < last_reloc_frame_ + max_frames && num_kfs > max_frames) return false;
@@ -210,11 +212,16 @@ bool Tracker::NeedNewKeyFrame(const Map& map, const Frame& frame, int inliers) c
       tracked_close < options_.close_tracked_max && untracked_close > options_.close_untracked_min;
   const double th_ref = num_kfs < 2 ? kNewKeyFrameRefRatioOneKf : options_.ref_ratio;
   const bool c1a = frame.index >= last_keyframe_frame_ + max_frames;
-  const bool c1b = true;  // sequential mapping: the local mapper is always idle here
+  const bool c1b = mapping.idle;  // always in sequential runs
   const bool c1c = inliers < kNewKeyFrameLowRatio * ref_matches || need_close;
   const bool c2 = (inliers < th_ref * ref_matches || need_close) && inliers > kMinKeyFrameInliers;
-  if (keyframe_requested_ && c1a && inliers > kMinKeyFrameInliers) return true;
-  return (c1a || c1b || c1c) && c2;
+  const bool wanted =
+      (keyframe_requested_ && c1a && inliers > kMinKeyFrameInliers) || ((c1a || c1b || c1c) && c2);
+  if (!wanted || mapping.idle) return wanted;
+  // Mapping is busy: ask it to cut its bundle adjustment short, and queue the keyframe only if
+  // few wait (ORB-SLAM3, RGB-D); otherwise a later frame asks again.
+  *interrupt = true;
+  return mapping.queued < kMaxQueuedKeyFrames;
 }
 
 KeyFrameId Tracker::CreateKeyFrame(Map& map, Frame* frame) {
