@@ -28,38 +28,26 @@ cv::Mat LoadGray(const char* relative) {
   return cv::imread(root + "/" + relative, cv::IMREAD_GRAYSCALE);
 }
 
-void BM_OrbExtract(benchmark::State& state) {
+// The Det-SLAM stage's ignore mask of two people (about a quarter of the image), or none.
+cv::Mat TwoPeopleMask(const cv::Size& size) {
+  cv::Mat mask = cv::Mat::zeros(size, CV_8UC1);
+  for (int x : {200, 450}) {
+    cv::ellipse(mask, {x, 300}, {80, 180}, 0, 0, 360, cv::Scalar(255), cv::FILLED);
+    cv::circle(mask, {x, 110}, 45, cv::Scalar(255), cv::FILLED);
+  }
+  return mask;
+}
+
+// Extraction without a mask, and with the two people's (cells the mask covers get no
+// low-threshold retry).
+void BM_OrbExtract(benchmark::State& state, bool two_people) {
   cv::setNumThreads(1);  // single-threaded figure: no OpenCV worker threads
   const cv::Mat gray = LoadGray(kFrameA);
   if (gray.empty()) {
     state.SkipWithError("shared TUM frame not found (set DETSLAM_SHARED)");
     return;
   }
-  const detslam::OrbExtractor extractor{detslam::OrbOptions{}};
-  std::vector<cv::KeyPoint> keypoints;
-  cv::Mat descriptors;
-  for (auto _ : state) {
-    extractor.Extract(gray, cv::Mat(), &keypoints, &descriptors);
-    benchmark::DoNotOptimize(descriptors.data);
-  }
-  state.counters["keypoints"] = static_cast<double>(keypoints.size());
-}
-BENCHMARK(BM_OrbExtract)->Unit(benchmark::kMillisecond);
-
-// The same with the Det-SLAM stage's ignore mask of two people (about a quarter of the image):
-// cells the mask covers get no low-threshold retry.
-void BM_OrbExtractMasked(benchmark::State& state) {
-  cv::setNumThreads(1);
-  const cv::Mat gray = LoadGray(kFrameA);
-  if (gray.empty()) {
-    state.SkipWithError("shared TUM frame not found (set DETSLAM_SHARED)");
-    return;
-  }
-  cv::Mat mask = cv::Mat::zeros(gray.size(), CV_8UC1);
-  for (int x : {200, 450}) {
-    cv::ellipse(mask, {x, 300}, {80, 180}, 0, 0, 360, cv::Scalar(255), cv::FILLED);
-    cv::circle(mask, {x, 110}, 45, cv::Scalar(255), cv::FILLED);
-  }
+  const cv::Mat mask = two_people ? TwoPeopleMask(gray.size()) : cv::Mat();
   const detslam::OrbExtractor extractor{detslam::OrbOptions{}};
   std::vector<cv::KeyPoint> keypoints;
   cv::Mat descriptors;
@@ -69,9 +57,11 @@ void BM_OrbExtractMasked(benchmark::State& state) {
   }
   state.counters["keypoints"] = static_cast<double>(keypoints.size());
   state.counters["masked_fraction"] =
-      static_cast<double>(cv::countNonZero(mask)) / static_cast<double>(mask.total());
+      mask.empty() ? 0.0
+                   : static_cast<double>(cv::countNonZero(mask)) / static_cast<double>(mask.total());
 }
-BENCHMARK(BM_OrbExtractMasked)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_OrbExtract, no_mask, false)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_OrbExtract, two_people, true)->Unit(benchmark::kMillisecond);
 
 void BM_MatchBruteForce(benchmark::State& state) {
   cv::setNumThreads(1);

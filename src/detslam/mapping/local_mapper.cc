@@ -68,11 +68,9 @@ LocalMappingSummary LocalMapper::ProcessKeyFrame(KeyFrameId current, MapStore* s
     }
     bundle_adjust = options_.local_ba && map.NumKeyFrames() > 2;
   }
-  if (!fuse) summary.skipped_for_waiting = true;
-  if (waiting()) {
-    summary.skipped_for_waiting = true;
-    return summary;
-  }
+  const bool skip_ba = waiting();
+  summary.skipped_for_waiting = !fuse || skip_ba;
+  if (skip_ba) return summary;
   if (bundle_adjust) LocalBundleAdjustment(store, current, control.abort_ba, &summary);
   if (options_.cull_keyframes) CullKeyFrames(*store->Write(), current, &summary);
   return summary;
