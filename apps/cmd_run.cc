@@ -154,17 +154,20 @@ void Run(RunArgs a) {
   if (!options.slam.Check(&error)) throw InputError(settings.source, 0, error);
   const std::string models_dir = a.models.empty() ? DefaultModelsDir() : a.models;
   std::string spec = a.segmenter;
+  // At camera rate the detector runs at its own input size (Segmentation.CameraRateInputSize).
+  const SegmenterSettings segmenter_settings =
+      a.realtime ? ForCameraRate(resolved.segmenter) : resolved.segmenter;
   std::unique_ptr<Segmenter> segmenter;
   if (spec.empty()) {
     try {
-      segmenter = MakeSegmenter("dnn", dataset.name(), resolved.segmenter, models_dir);
+      segmenter = MakeSegmenter("dnn", dataset.name(), segmenter_settings, models_dir);
       spec = "dnn";
     } catch (const InputError& e) {
       std::fprintf(stderr, "note: no dynamic-object segmentation (pass --segmenter dnn|masks:DIR|gt|none): %s\n", e.what());
       spec = "none";
     }
   } else {
-    segmenter = MakeSegmenter(spec, dataset.name(), resolved.segmenter, models_dir);
+    segmenter = MakeSegmenter(spec, dataset.name(), segmenter_settings, models_dir);
   }
   std::printf("detslam run (%s, segmenter %s): %zu frames from %s (settings: %s)\n",
               a.realtime ? "camera rate" : a.threaded ? "threaded" : "sequential", spec.c_str(), dataset.size(), dataset.name().c_str(),

@@ -11,6 +11,7 @@
 #include <functional>
 #include <mutex>
 #include <numeric>
+#include <optional>
 #include <thread>
 
 #include "detslam/core/check.h"
@@ -578,6 +579,9 @@ RunSummary RunThreaded(const RgbdSource& dataset, const Settings& settings,
       }
     });
   }
+  // When the last processed frame got its pose (the processed frame rate's end, not the threads'
+  // ends: the mapping and segmentation threads finish their current work after it).
+  std::optional<std::chrono::steady_clock::time_point> last_pose;
   stages.RunHere(
       "tracking",
       [&] {
@@ -592,9 +596,9 @@ RunSummary RunThreaded(const RgbdSource& dataset, const Settings& settings,
           const KeyFrameId kf =
               slam.TrackFrame(std::move(e->frame), &e->report, observer ? &tracked : nullptr);
           if (options.realtime) {
-            e->report.latency_ms = std::chrono::duration<double, std::milli>(
-                                       std::chrono::steady_clock::now() - e->arrival)
-                                       .count();
+            last_pose = std::chrono::steady_clock::now();
+            e->report.latency_ms =
+                std::chrono::duration<double, std::milli>(*last_pose - e->arrival).count();
           }
           recorder.AddFrameMasks(options, e->report.index, kf != kNoKeyFrame, e->instances,
                                  e->depth_m);
@@ -613,8 +617,9 @@ RunSummary RunThreaded(const RgbdSource& dataset, const Settings& settings,
       [&] { keyframes.Close(); });
   stages.Join();
   if (options.realtime) {
+    const auto end = last_pose.value_or(std::chrono::steady_clock::now());
     recorder.SetCamera(offered, std::move(dropped),
-                       std::chrono::duration<double>(std::chrono::steady_clock::now() - camera_start).count());
+                       std::chrono::duration<double>(end - camera_start).count());
   }
   if (async) recorder.SetAsyncSegmentation(detection_ms);
   return Finish(recorder, dataset, settings, options, slam, start, segmenter);

@@ -98,7 +98,7 @@ struct RunSummary {
   // the frames processed (ms; also its 99th percentile).
   size_t offered = 0;
   std::vector<int64_t> dropped_frames;
-  double camera_s = 0;  // from the camera's start (after preloading) to the last frame's end
+  double camera_s = 0;  // from the camera's start (after preloading) to the last frame's pose
   double ProcessedFps() const { return camera_s > 0 ? frames / camera_s : 0.0; }
   ErrorStats latency;
   double latency_p99_ms = 0;

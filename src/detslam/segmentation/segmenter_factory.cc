@@ -9,6 +9,11 @@
 
 namespace detslam {
 
+SegmenterSettings ForCameraRate(SegmenterSettings settings) {
+  settings.dnn.yolox_input_size = settings.camera_rate_input_size;
+  return settings;
+}
+
 std::unique_ptr<Segmenter> MakeSegmenter(const std::string& spec, const std::string& dataset_dir,
                                          const SegmenterSettings& settings, const std::string& models_dir) {
   if (spec == "none") return nullptr;

@@ -87,6 +87,22 @@ TEST(DnnOptions, FromSettingsResolvesCompanionsAndClasses) {
   EXPECT_TRUE(d.Check(&error)) << error;
 }
 
+TEST(DnnOptions, CameraRateUsesItsOwnInputSize) {
+  SegmenterSettings s;
+  s.dnn.yolox_input_size = 448;
+  s.camera_rate_input_size = 256;
+  s.dnn.score_threshold = 0.4f;
+  const SegmenterSettings live = ForCameraRate(s);
+  EXPECT_EQ(live.dnn.yolox_input_size, 256);
+  EXPECT_FLOAT_EQ(live.dnn.score_threshold, 0.4f);  // nothing else changes
+  EXPECT_EQ(live.detector, s.detector);
+  EXPECT_EQ(DnnOptionsFromSettings(live, "/m").yolox_input_size, 256);
+  EXPECT_EQ(DnnOptionsFromSettings(s, "/m").yolox_input_size, 448);
+  // The defaults: 416 offline, 320 at camera rate.
+  EXPECT_EQ(SegmenterSettings().dnn.yolox_input_size, 416);
+  EXPECT_EQ(ForCameraRate(SegmenterSettings()).dnn.yolox_input_size, 320);
+}
+
 TEST(DnnOptions, SecondDetectorDefaultIsOptionalAndExplicitOneIsKept) {
   // Default: the second detector is used only where its file exists in the models folder.
   SegmenterSettings none_set;

@@ -26,11 +26,18 @@ struct SegmenterSettings {
       "mask_rcnn_inception_v2_coco/mask_rcnn_inception_v2_coco_2018_01_28.pbtxt";
   std::string maskrcnn_names = "mask_rcnn_inception_v2_coco/object_detection_classes_coco.txt";
   DnnSegmenterOptions dnn;   // thresholds, sizes, classes (its paths are filled from the above)
+  // The YOLOX input side in the camera-rate mode (--realtime), in place of dnn.yolox_input_size:
+  // a smaller input makes the detector faster and the masks the frames get fresher (see
+  // ForCameraRate).
+  int camera_rate_input_size = 320;
   MaskRcnnOptions maskrcnn;  // score threshold, classes (its paths are filled from the above)
 
   // The segmenters return only the dynamic classes: Dynamic.Classes sets them with the filter's,
   // and its default is theirs too. Masks of the other classes would be computed for nothing.
   SegmenterSettings() { dnn.classes = maskrcnn.classes = DefaultDynamicClasses(); }
 };
+
+// The settings a camera-rate run (--realtime) segments with: YOLOX input camera_rate_input_size.
+SegmenterSettings ForCameraRate(SegmenterSettings settings);
 
 }  // namespace detslam
