@@ -5,9 +5,11 @@
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <opencv2/core/utility.hpp>
 #include <sstream>
 #include <thread>
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cstdio>
 
@@ -225,18 +227,23 @@ class SlowSegmenter : public Segmenter {
  public:
   explicit SlowSegmenter(int ms) : ms_(ms) {}
   std::vector<Instance> Segment(const SegmenterInput&) override {
+    opencv_threads_ = cv::getNumThreads();
     std::this_thread::sleep_for(std::chrono::milliseconds(ms_));
     return {};
   }
   std::string name() const override { return "slow"; }
+  // cv::getNumThreads() in the last Segment call.
+  int opencv_threads() const { return opencv_threads_; }
 
  private:
   int ms_;
+  std::atomic<int> opencv_threads_{-1};
 };
 
 // 60 frames of a static 30 fps sequence at camera rate (threaded, mapping thread), with a segmenter
 // that takes `segmenter_ms` per frame; *options: those of the run.
-RunSummary RunAtCameraRate(const std::string& name, bool async, int segmenter_ms, RunOptions* options) {
+RunSummary RunAtCameraRate(const std::string& name, bool async, int segmenter_ms, RunOptions* options,
+                           int* segmenter_opencv_threads = nullptr) {
   const std::string seq = WriteStaticSequence(name, 1, 60);
   const RgbdDataset dataset = RgbdDataset::Open(seq, {});
   const Settings settings = PresetForDataset(seq);
@@ -247,7 +254,9 @@ RunSummary RunAtCameraRate(const std::string& name, bool async, int segmenter_ms
   options->async_segmentation = async;
   options->slam = SlamOptionsFromSettings(settings, 42);
   SlowSegmenter segmenter(segmenter_ms);
-  return detslam::Run(dataset, settings, *options, nullptr, &segmenter);
+  RunSummary s = detslam::Run(dataset, settings, *options, nullptr, &segmenter);
+  if (segmenter_opencv_threads) *segmenter_opencv_threads = segmenter.opencv_threads();
+  return s;
 }
 
 // Every offered frame is either processed (in order) or dropped, never both.
@@ -273,7 +282,13 @@ void ExpectEveryFrameProcessedOrDropped(const RunSummary& s, int64_t offered) {
 // frames would wait up to 4 s by the end).
 TEST(IntegrationRunner, CameraRateDropsTheFramesThePipelineCannotTake) {
   RunOptions options;
-  const RunSummary s = RunAtCameraRate("camera_rate", /*async=*/false, 100, &options);
+  const int opencv_threads = cv::getNumThreads();
+  int segmenter_opencv_threads = -1;
+  const RunSummary s =
+      RunAtCameraRate("camera_rate", /*async=*/false, 100, &options, &segmenter_opencv_threads);
+  // The run's OpenCV threads (RunOptions::camera_rate_opencv_threads) while it lasts, not after.
+  EXPECT_EQ(segmenter_opencv_threads, options.camera_rate_opencv_threads);
+  EXPECT_EQ(cv::getNumThreads(), opencv_threads);
   EXPECT_EQ(s.offered, 60u);
   EXPECT_EQ(s.frames + s.dropped_frames.size(), 60u);
   EXPECT_GE(s.dropped_frames.size(), 30u) << "frames were queued, not dropped";

@@ -14,6 +14,8 @@
 #include <optional>
 #include <thread>
 
+#include <opencv2/core/utility.hpp>
+
 #include "detslam/core/check.h"
 #include "detslam/dynamic/mask_carrier.h"
 #include "detslam/pipeline/bounded_queue.h"
@@ -345,6 +347,24 @@ size_t OfferAtCameraRate(const RgbdSource& dataset, const Settings& settings, si
   return offered;
 }
 
+// OpenCV's thread count (cv::setNumThreads) for a scope: `n` > 0 sets it, 0 leaves it; the count
+// before is restored at the end.
+class OpenCvThreads {
+ public:
+  explicit OpenCvThreads(int n) : before_(cv::getNumThreads()), set_(n > 0) {
+    if (set_) cv::setNumThreads(n);
+  }
+  ~OpenCvThreads() {
+    if (set_) cv::setNumThreads(before_);
+  }
+  OpenCvThreads(const OpenCvThreads&) = delete;
+  OpenCvThreads& operator=(const OpenCvThreads&) = delete;
+
+ private:
+  int before_;
+  bool set_;
+};
+
 // The report of a frame whose images could not be read (f.unreadable is set).
 FrameReport SkippedReport(const RgbdSource& dataset, const LoadedFrame& f) {
   FrameReport r;
@@ -430,6 +450,7 @@ RunSummary RunThreaded(const RgbdSource& dataset, const Settings& settings,
                        Segmenter* segmenter) {
   const auto start = std::chrono::steady_clock::now();
   CheckOutputs(options);
+  const OpenCvThreads cv_threads(options.realtime ? options.camera_rate_opencv_threads : 0);
   SlamOptions slam_options = options.slam;
   slam_options.global_ba_thread = options.mapping_thread;  // nothing waits for it then
   SlamSystem slam(settings.camera, slam_options, segmenter);

@@ -47,6 +47,12 @@ struct RunOptions {
   // that when the cores are busy the frames' path (camera, extraction, tracking) gets them first.
   // 5 was chosen on walking_xyz tuning seeds 1-3 (docs/BENCHMARKS.md, section realtime).
   int background_nice = 5;
+  // Camera-rate mode: OpenCV's threads during the run (cv::setNumThreads, process-wide; restored
+  // after it); 0 keeps OpenCV's default (one per core). Mostly the detector's network uses them:
+  // with 1 it runs in the segmentation thread alone, at that thread's lower priority, instead of
+  // also on a worker thread that competes with the frames' path. 1 was chosen on the tuning seeds
+  // 1-3 of the four walking presets (README, Options).
+  int camera_rate_opencv_threads = 1;
   std::string save_map;         // write the final map to this map file (empty: none)
   std::string load_map;         // start from the map in this map file (empty: a new map)
   // The dense static map (dense/dense_fusion.h): after the run, the main map's keyframes are fused

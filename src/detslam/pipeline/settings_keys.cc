@@ -135,6 +135,7 @@ std::vector<Binding> MakeBindings() {
   k.push_back(Key("Segmentation.NmsThreshold", 0, 1, "dnn: IoU above which same-class boxes are suppressed", [](auto& r) -> auto& { return r.segmenter.dnn.nms_threshold; }));
   k.push_back(Key("Segmentation.BoxExpand", 0, kInf, "dnn: person box grown by this fraction per side for the mask crop", [](auto& r) -> auto& { return r.segmenter.dnn.box_expand; }));
   k.push_back(Key("Segmentation.InputSize", 32, kInf, "dnn: YOLOX input side (multiple of 32)", [](auto& r) -> auto& { return r.segmenter.dnn.yolox_input_size; }));
+  k.push_back(Key("Segmentation.CameraRateOpenCvThreads", 0, kInf, "camera-rate mode (--realtime): OpenCV threads during the run (the detector's network is their main user; process-wide), 0 = OpenCV's default (one per core)", [](auto& r) -> auto& { return r.run.camera_rate_opencv_threads; }));
   k.push_back(Key("Segmentation.CameraRateInputSize", 32, kInf, "dnn, camera-rate mode (--realtime): YOLOX input side (multiple of 32) used there instead of Segmentation.InputSize (a faster detector gives fresher masks)", [](auto& r) -> auto& { return r.segmenter.camera_rate_input_size; }));
   k.push_back(Key("Segmentation.PersonMaskMinFill", 0, 1, "dnn: person mask fill of the box below which the depth mask is used", [](auto& r) -> auto& { return r.segmenter.dnn.person_mask_min_fill; }));
   k.push_back(Key("Segmentation.SecondDetector", "dnn: second detector for boxes the first missed (empty: yolo-fastest-1.1-xl when found; none)", [](auto& r) -> auto& { return r.segmenter.second_detector; }));
