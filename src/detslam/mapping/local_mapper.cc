@@ -60,14 +60,8 @@ LocalMappingSummary LocalMapper::ProcessKeyFrame(KeyFrameId current, MapStore* s
   if (options_.triangulate) TriangulateNewLandmarks(store, current, &summary);
   // With more keyframes waiting, fusion and then BA and culling are left to a later keyframe.
   const bool fuse = !waiting();
-  {
-    const MapStore::WriteAccess access = store->Write();
-    Map& map = *access;
-    if (fuse && options_.fuse && map.HasKeyFrame(current)) {
-      FuseWithNeighbours(map, current, &summary);
-    }
-    bundle_adjust = options_.local_ba && map.NumKeyFrames() > 2;
-  }
+  if (fuse && options_.fuse) FuseWithNeighbours(store, current, &summary);
+  bundle_adjust = options_.local_ba && store->Read()->NumKeyFrames() > 2;
   const bool skip_ba = waiting();
   summary.skipped_for_waiting = !fuse || skip_ba;
   if (skip_ba) return summary;
@@ -92,40 +86,57 @@ void LocalMapper::CullLandmarks(Map& map, KeyFrameId current, LocalMappingSummar
   recent_landmarks_ = std::move(keep);
 }
 
-void LocalMapper::FuseWithNeighbours(Map& map, KeyFrameId current, LocalMappingSummary* summary) {
-  std::vector<KeyFrameId> targets =
-      map.BestCovisibles(current, static_cast<size_t>(options_.fuse_neighbours));
-  std::set<KeyFrameId> target_set(targets.begin(), targets.end());
-  const size_t first_order = targets.size();
-  for (size_t k = 0; k < first_order; ++k) {
-    for (KeyFrameId n : map.BestCovisibles(targets[k], 5)) {
-      if (n != current && target_set.insert(n).second) targets.push_back(n);
+void LocalMapper::FuseWithNeighbours(MapStore* store, KeyFrameId current,
+                                     LocalMappingSummary* summary) {
+  // Each step under its own write access, one neighbour at a time: the tracker may take the map
+  // between them (a whole fusion under one access held tracking up for tens of milliseconds at
+  // camera rate). The steps and their order are those of one access; a keyframe removed meanwhile
+  // is skipped.
+  std::vector<KeyFrameId> targets;
+  {
+    const MapStore::ReadAccess map = store->Read();
+    if (!map->HasKeyFrame(current)) return;
+    targets = map->BestCovisibles(current, static_cast<size_t>(options_.fuse_neighbours));
+    std::set<KeyFrameId> target_set(targets.begin(), targets.end());
+    const size_t first_order = targets.size();
+    for (size_t k = 0; k < first_order; ++k) {
+      for (KeyFrameId n : map->BestCovisibles(targets[k], 5)) {
+        if (n != current && target_set.insert(n).second) targets.push_back(n);
+      }
     }
   }
   ProjectionSearchOptions opt;
   opt.window = 3.0;
   opt.ratio = 1.0;
   opt.max_distance = kThLow;
-  auto fuse_into = [&](KeyFrameId into, const std::vector<LandmarkId>& sources) {
+  auto fuse_into = [&](Map& map, KeyFrameId into, const std::vector<LandmarkId>& sources) {
     summary->fused +=
         FuseLandmarksInto(camera_, map, into, sources, map.keyframe(into).cam_from_world, opt,
                           FuseWinner::kMoreObserved);
   };
   for (KeyFrameId t : targets) {
+    const MapStore::WriteAccess access = store->Write();
+    Map& map = *access;
+    if (!map.HasKeyFrame(current)) return;
+    if (!map.HasKeyFrame(t)) continue;
     std::vector<LandmarkId> mine;
     for (LandmarkId id : map.keyframe(current).landmarks) {
       if (id != kNoLandmark) mine.push_back(id);
     }
-    fuse_into(t, mine);
+    fuse_into(map, t, mine);
   }
+  const MapStore::WriteAccess access = store->Write();
+  Map& map = *access;
+  if (!map.HasKeyFrame(current)) return;
   std::vector<LandmarkId> theirs;
   std::set<LandmarkId> seen;
   for (KeyFrameId t : targets) {
+    if (!map.HasKeyFrame(t)) continue;
     for (LandmarkId id : map.keyframe(t).landmarks) {
       if (id != kNoLandmark && seen.insert(id).second) theirs.push_back(id);
     }
   }
-  fuse_into(current, theirs);
+  fuse_into(map, current, theirs);
   for (LandmarkId id : map.keyframe(current).landmarks) {
     if (id == kNoLandmark) continue;
     map.UpdateLandmarkDescriptor(id);

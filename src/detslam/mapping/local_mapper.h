@@ -67,7 +67,8 @@ class LocalMapper {
   // Processes a keyframe just inserted by the tracker. Deterministic (with the default control).
   // Every step holds the store's write access except the triangulation's descriptor matching (one
   // neighbour at a time) and the bundle-adjustment solve (on a snapshot,
-  // MapStore::ComputeOutsideLock), which run while the tracker may use the map.
+  // MapStore::ComputeOutsideLock), which run while the tracker may use the map; landmark fusion
+  // takes the access once per neighbour keyframe.
   LocalMappingSummary ProcessKeyFrame(KeyFrameId kf, MapStore* store,
                                       const LocalMappingControl& control = {});
 
@@ -75,7 +76,7 @@ class LocalMapper {
   void CullLandmarks(Map& map, KeyFrameId current, LocalMappingSummary* summary);
   void TriangulateNewLandmarks(MapStore* store, KeyFrameId current,
                                LocalMappingSummary* summary);  // triangulate.cc
-  void FuseWithNeighbours(Map& map, KeyFrameId current, LocalMappingSummary* summary);
+  void FuseWithNeighbours(MapStore* store, KeyFrameId current, LocalMappingSummary* summary);
   void LocalBundleAdjustment(MapStore* store, KeyFrameId current,
                              const std::atomic<bool>* abort_ba, LocalMappingSummary* summary);
   void CullKeyFrames(Map& map, KeyFrameId current, LocalMappingSummary* summary);

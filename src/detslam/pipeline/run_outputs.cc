@@ -283,6 +283,7 @@ void WriteRunOutputs(const RgbdSource& dataset, const Settings& settings, const 
                          {"segmentation_ms", r.segmentation_ms},
                          {"extraction_ms", r.timings.extraction_ms},
                          {"tracking_ms", r.timings.tracking_ms},
+                         {"map_wait_ms", r.timings.map_wait_ms},
                          {"mapping_ms", r.timings.mapping_ms}});
     if (r.latency_ms >= 0) per_frame.back()["latency_ms"] = r.latency_ms;
     if (r.mask_age >= 0) {

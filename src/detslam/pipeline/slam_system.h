@@ -75,6 +75,9 @@ struct MapTrajectories {
 // Wall-clock time of each stage for one frame, milliseconds.
 struct FrameTimings {
   double extraction_ms = 0, tracking_ms = 0, mapping_ms = 0;
+  // Of tracking_ms: the wait for the map's lock (held by local mapping or loop closing when they
+  // run in another thread).
+  double map_wait_ms = 0;
 };
 
 struct FrameReport {
