@@ -39,7 +39,6 @@ LocalMappingSummary LocalMapper::ProcessKeyFrame(KeyFrameId current, MapStore* s
     return control.keyframes_waiting && control.keyframes_waiting();
   };
   LocalMappingSummary summary;
-  bool bundle_adjust = false;
   {
     const MapStore::WriteAccess access = store->Write();
     Map& map = *access;
@@ -61,7 +60,7 @@ LocalMappingSummary LocalMapper::ProcessKeyFrame(KeyFrameId current, MapStore* s
   // With more keyframes waiting, fusion and then BA and culling are left to a later keyframe.
   const bool fuse = !waiting();
   if (fuse && options_.fuse) FuseWithNeighbours(store, current, &summary);
-  bundle_adjust = options_.local_ba && store->Read()->NumKeyFrames() > 2;
+  const bool bundle_adjust = options_.local_ba && store->Read()->NumKeyFrames() > 2;
   const bool skip_ba = waiting();
   summary.skipped_for_waiting = !fuse || skip_ba;
   if (skip_ba) return summary;
