@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <utility>
+#include <vector>
 #include <opencv2/core/utility.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -16,17 +18,25 @@ constexpr double kTwoPi = 6.283185307179586;
 
 // A smooth standard-normal random field: independent normals at the nodes of a grid of `cell`
 // pixels, interpolated bilinearly and renormalised so that every pixel's value is N(0, 1).
-// `frame` < 0 gives a field that is the same in every frame.
+// `frame` < 0 gives a field that is the same in every frame. The nodes an image of `width` x
+// `height` needs are drawn once, at construction (each node is shared by up to cell^2 pixels);
+// a pixel outside the image draws its own (the same values: a node is a function of its key).
 class SmoothField {
  public:
-  SmoothField(uint64_t seed, int64_t frame, int cell, uint64_t channel)
+  SmoothField(uint64_t seed, int64_t frame, int cell, uint64_t channel, int width, int height)
       : seed_(seed), frame_(static_cast<uint64_t>(frame)), cell_(std::max(1, cell)),
-        channel_(channel) {}
+        channel_(channel), cols_(width / cell_ + 2), rows_(height / cell_ + 2) {
+    nodes_.resize(static_cast<size_t>(cols_) * rows_);
+    for (int j = 0; j < rows_; ++j)
+      for (int i = 0; i < cols_; ++i) nodes_[static_cast<size_t>(j) * cols_ + i] = Draw(i, j);
+    for (int u = 0; u < width; ++u) columns_.push_back(Cell(u));
+    for (int v = 0; v < height; ++v) rows_of_image_.push_back(Cell(v));
+  }
 
   double At(int u, int v) const {
-    const double x = (u + 0.5) / cell_, y = (v + 0.5) / cell_;
-    const int64_t i = static_cast<int64_t>(std::floor(x)), j = static_cast<int64_t>(std::floor(y));
-    const double fx = x - i, fy = y - j;
+    const auto [i, fx] = u >= 0 && u < static_cast<int>(columns_.size()) ? columns_[u] : Cell(u);
+    const auto [j, fy] =
+        v >= 0 && v < static_cast<int>(rows_of_image_.size()) ? rows_of_image_[v] : Cell(v);
     const double w[4] = {(1 - fx) * (1 - fy), fx * (1 - fy), (1 - fx) * fy, fx * fy};
     const double n[4] = {Node(i, j), Node(i + 1, j), Node(i, j + 1), Node(i + 1, j + 1)};
     double value = 0, norm = 0;
@@ -38,13 +48,27 @@ class SmoothField {
   }
 
  private:
+  // The grid cell of pixel coordinate `c` and the fraction of the way across it.
+  std::pair<int64_t, double> Cell(int c) const {
+    const double x = (c + 0.5) / cell_;
+    const int64_t i = static_cast<int64_t>(std::floor(x));
+    return {i, x - i};
+  }
   double Node(int64_t i, int64_t j) const {
+    if (i >= 0 && i < cols_ && j >= 0 && j < rows_)
+      return nodes_[static_cast<size_t>(j) * cols_ + static_cast<size_t>(i)];
+    return Draw(i, j);
+  }
+  double Draw(int64_t i, int64_t j) const {
     const uint64_t node = static_cast<uint64_t>((j + 4096) * 8192 + (i + 4096));
     return HashNormal(HashKey(seed_, frame_, node, channel_));
   }
   uint64_t seed_, frame_;
   int cell_;
   uint64_t channel_;
+  int cols_, rows_;
+  std::vector<double> nodes_;
+  std::vector<std::pair<int64_t, double>> columns_, rows_of_image_;  // Cell() of each u, each v
 };
 
 // z such that P(N(0,1) > z) = p, by bisection on erfc (p in (0, 1)).
@@ -95,11 +119,11 @@ cv::Mat MakeKinectDepth16(const cv::Mat& depth, const cv::Mat& infrared, const P
   const cv::Mat shadow = model.shadows ? ProjectorShadow(depth, camera.fx, model.baseline,
                                                          model.shadow_tolerance_px)
                                         : cv::Mat::zeros(depth.size(), CV_8U);
-  const SmoothField bias(device_seed, -1, model.bias_cell_px, 11);
-  const SmoothField correlated(seed, frame, model.correlation_px, 12);
+  const SmoothField bias(device_seed, -1, model.bias_cell_px, 11, w, h);
+  const SmoothField correlated(seed, frame, model.correlation_px, 12, w, h);
   // Holes of irregular shape: two scales of random field.
-  const SmoothField holes(seed, frame, model.hole_cell_px, 13);
-  const SmoothField hole_detail(seed, frame, std::max(1, model.hole_cell_px / 3), 14);
+  const SmoothField holes(seed, frame, model.hole_cell_px, 13, w, h);
+  const SmoothField hole_detail(seed, frame, std::max(1, model.hole_cell_px / 3), 14, w, h);
   const double hole_level = UpperNormalQuantile(std::clamp(model.hole_fraction, 1e-9, 1 - 1e-9));
   const float fx = static_cast<float>(camera.fx), fy = static_cast<float>(camera.fy);
   const float cx = static_cast<float>(camera.cx), cy = static_cast<float>(camera.cy);
