@@ -38,7 +38,7 @@ std::string Sequence(const std::string& name, int frames, double cover_start_s =
     so.cover_start_s = cover_start_s;
     so.cover_seconds = 10.0 / 30.0;  // frames of black colour and no depth
   }
-  WriteSequence(so, dir);
+  integration::WriteTestSequence(so, dir);
   return dir;
 }
 
