@@ -15,10 +15,16 @@
 #     extended with path 2 (no --localization): maps left, ATE of path 2 against mapping it alone;
 #  C. loading a map made from BIG_FRAMES frames (loop_long preset: a 9 x 5 m circuit in a large
 #     office, --segmenter none): load time (a timing: run it on a quiet machine);
-# and writes the tables into docs/BENCHMARKS.md (sections atlas-cover, atlas-files, atlas-load: one
-# per part) via bench/update_section.py.
+#  D. false merges: the `lookalike` preset (two parts of a long room with the same textures in
+#     other layouts) with `--cover 20:7`, which hides the passage between them: the new map starts
+#     in the second part, where every place looks like one of the first map's; each merge is checked
+#     against ground truth (false: the true camera centres of its two frames more than 4 m apart),
+#     LOOKALIKE_SEEDS (evaluation seeds; the cover was chosen on seed 1), ground-truth masks;
+# and writes the tables into docs/BENCHMARKS.md (sections atlas-cover, atlas-files, atlas-load,
+# atlas-false-merges: one per part) via bench/update_section.py.
 # Usage: bench/bench_atlas.sh [path/to/detslam]
-#   (env: ROAM_SEEDS="101 102 103", MAP_FRAMES=500, BIG_FRAMES=3000, PARTS="A B C")
+#   (env: ROAM_SEEDS="101 102 103", MAP_FRAMES=500, BIG_FRAMES=3000,
+#    LOOKALIKE_SEEDS="101 102 103", PARTS="A B C D")
 set -euo pipefail
 # The synthetic sensor model (`detslam synth --realism`): realistic, the generator's default;
 # REALISM=easy gives the first generator's sequences.
@@ -29,8 +35,9 @@ bin="${1:-$root/build/bin/detslam}"
 roam_seeds="${ROAM_SEEDS:-101 102 103}"
 map_frames="${MAP_FRAMES:-500}"
 big_frames="${BIG_FRAMES:-3000}"
-parts="${PARTS:-A B C}"
-settings_line="bench/bench_atlas.sh (ROAM_SEEDS=\"$roam_seeds\" MAP_FRAMES=$map_frames BIG_FRAMES=$big_frames REALISM=$realism)"
+lookalike_seeds="${LOOKALIKE_SEEDS:-101 102 103}"
+parts="${PARTS:-A B C D}"
+settings_line="bench/bench_atlas.sh (ROAM_SEEDS=\"$roam_seeds\" MAP_FRAMES=$map_frames BIG_FRAMES=$big_frames LOOKALIKE_SEEDS=\"$lookalike_seeds\" REALISM=$realism)"
 work="$(mktemp -d)"
 trap 'rm -rf "$work"' EXIT
 bench_name=bench_atlas
@@ -175,5 +182,47 @@ PY
   echo
 } >"$out"
 publish atlas-load "$out"
+fi
+
+out="$work/section_d.md"
+if want D; then
+{
+  echo "### D. False merges: \`lookalike\` with \`--cover 20:7\` (frames 600-809 black, no depth), evaluation seeds $lookalike_seeds"
+  echo
+  echo "The camera explores the first part of a long room, then, while the lens is covered, walks"
+  echo "through the passage into the second part, whose furnishings have the first part's textures in"
+  echo "another layout (every item moved by a different step and resized). The new map starts there;"
+  echo "the first part is never seen again, so no merge is true: each merge (run.json \`loops\` with"
+  echo "\`merge\`) is checked against ground truth, false when the true camera centres of its two"
+  echo "frames are more than 4 m apart (the two parts are 6.8 m apart). Ground-truth masks as"
+  echo "segmenter. Target: no false merge; the second part's frames stay in trajectory_map1.txt."
+  echo
+  echo "| seed | frames not black | posed (all maps) | in trajectory.txt | maps started | merge candidates examined / passed rigid RANSAC / verified | merges | of which false (ground truth) | maps left | ATE RMSE mm (trajectory.txt) |"
+  echo "|---:|---:|---:|---:|---:|---|---:|---:|---:|---:|"
+} >"$out"
+false_merges=0
+for s in $lookalike_seeds; do
+  progress "D: lookalike seed $s"
+  "$bin" synth --realism "$realism" --preset lookalike --seed "$s" --cover 20:7 --out "$work/la_$s" >/dev/null 2>&1
+  run_eval "$work/la_$s" "$work/la_${s}_run" --segmenter gt
+  read -r true_merges false_n < <(m loops "$work/la_${s}_run/run.json" "$work/la_$s/groundtruth.txt" 4)
+  false_merges=$((false_merges + false_n))
+  python3 - "$work/la_${s}_run/run.json" "$s" "$false_n" "$(mm "$(m field "$work/la_${s}_run/eval.json" ate.rmse)")" >>"$out" <<'PY'
+import json, sys
+j = json.load(open(sys.argv[1]))
+maps, ld = j["maps"], j["loop_detection"]
+merges = sum(1 for l in j["loops"] if l["merge"])
+print(f"| {sys.argv[2]} | {j['frames'] - 210} | {j['frames_tracked']} | {j['frames_in_main_map']} | "
+      f"{maps['started']} | {ld['candidates']} / {ld['rigid_ransac']} / {ld['verified']} | {merges} | "
+      f"{sys.argv[3]} | {maps['left']} | {sys.argv[4]} |")
+PY
+done
+{
+  echo
+  echo "False merges over the seeds: $false_merges. (Loop candidates count those of both maps: within"
+  echo "the second map too, where no loop is true either.)"
+  echo
+} >>"$out"
+publish atlas-false-merges "$out"
 fi
 python3 "$here/readme_summary.py"

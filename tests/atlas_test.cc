@@ -1,8 +1,8 @@
 // Several maps (the atlas) on the roam preset with a covered lens: while the lens is covered the
 // camera turns towards ground it has never seen, so relocalisation cannot succeed afterwards. A new
 // map must start from the first frame after the cover, the camera's return to its start must merge
-// it into the first map, and trajectory.txt (the main map) must then hold every frame that is not
-// black, as accurately as the uncovered twin's.
+// it into the first map (welding the seam), and trajectory.txt (the main map) must then hold every
+// frame that is not black, as accurately as the uncovered twin's.
 #include <gtest/gtest.h>
 
 #include <utility>
@@ -19,6 +19,7 @@ struct AtlasRun {
   int new_maps = 0;          // frames that started a new map after tracking was lost
   int first_map_after = -1;  // map of the first frame tracked after the cover
   int merges = 0;
+  int welded = 0;  // keyframes the merges' seam bundle adjustments optimised
   size_t main_frames = 0;  // frames in the main map at the end
   size_t maps_left = 0;
   double ate_m = 0;
@@ -57,6 +58,7 @@ std::pair<AtlasRun, AtlasRun> RunRoam(const SynthOptions& covered_options) {
   for (int i = 0; i < 2; ++i) {
     AtlasRun& run = runs[i];
     run.merges = slams[i]->maps_merged();
+    for (const LoopRecord& loop : slams[i]->loops()) run.welded += loop.merge ? loop.welded_keyframes : 0;
     const MapTrajectories all = slams[i]->FrameTrajectories();
     run.maps_left = all.by_map.size();
     run.main_frames = all.by_map.at(all.main_map).size();
@@ -80,6 +82,8 @@ TEST(IntegrationAtlas, CoveredLensStartsANewMapThatMergesOnTheWayBack) {
   EXPECT_EQ(covered.new_maps, 1);
   EXPECT_EQ(covered.first_map_after, 1);  // relocalisation in map 0 cannot succeed there
   EXPECT_EQ(covered.merges, 1);
+  // Welded: the seam's window on both sides bundle-adjusted (then fixed in the pose graph).
+  EXPECT_GE(covered.welded, 2);
   EXPECT_EQ(covered.maps_left, 1u);
   // Every frame that is not black ends up in the main map.
   EXPECT_GE(covered.main_frames, static_cast<size_t>(0.95 * (covered.frames - covered.black)));

@@ -36,6 +36,8 @@ bool LoopClosingOptions::Check(std::string* error) const {
     os << "min_matches and min_ransac_inliers must be >= 3; ";
   if (!(ransac_inlier_m > 0)) os << "ransac_inlier_m must be positive; ";
   if (min_verified_inliers < 3) os << "min_verified_inliers must be >= 3; ";
+  if (merge_weld_keyframes < 0) os << "merge_weld_keyframes must be >= 0; ";
+  if (merge_weld_iterations < 1) os << "merge_weld_iterations must be >= 1; ";
   if (error) *error = os.str();
   return os.str().empty();
 }
@@ -131,7 +133,7 @@ void LoopCloser::Close(Map& map, KeyFrameId kf_id, const Verified& loop,
       Eigen::AngleAxisd(loop.correction.rotation()).angle() * 180.0 / M_PI;
   if (moved_m < options_.revisit_max_correction_m &&
       turned_deg < options_.revisit_max_correction_deg) {
-    Correct(map, kf_id, loop, /*correct_poses=*/false, result);
+    Correct(map, kf_id, loop, /*correct_poses=*/false, /*moved=*/nullptr, result);
     result->revisit = true;
     ++stats_.revisits;
     spdlog::info(
@@ -141,7 +143,7 @@ void LoopCloser::Close(Map& map, KeyFrameId kf_id, const Verified& loop,
         turned_deg);
     return;
   }
-  Correct(map, kf_id, loop, /*correct_poses=*/true, result);
+  Correct(map, kf_id, loop, /*correct_poses=*/true, /*moved=*/nullptr, result);
   result->closed = true;
   ++loops_closed_;
   spdlog::info(
@@ -165,7 +167,9 @@ void LoopCloser::Merge(Map& map, KeyFrameId kf_id, Verified loop, LoopClosingRes
   // The verified pose of the keyframe, in the merged map's frame: now close to its own pose.
   if (!move_current) loop.cam_from_world = loop.cam_from_world * loop.correction;
   loop.correction = loop.cam_from_world.Inverse() * map.keyframe(kf_id).cam_from_world;
-  Correct(map, kf_id, loop, /*correct_poses=*/true, result);
+  std::set<KeyFrameId> moved;
+  for (const auto& [id, pose] : before) moved.insert(id);
+  Correct(map, kf_id, loop, /*correct_poses=*/true, &moved, result);
   // The tracker moves its last frame from the poses before the whole step.
   for (const auto& [id, pose] : before) result->old_poses[id] = pose;
   result->closed = true;
@@ -175,9 +179,42 @@ void LoopCloser::Merge(Map& map, KeyFrameId kf_id, Verified loop, LoopClosingRes
   ++maps_merged_;
   spdlog::info(
       "maps merged: map {} into map {} at keyframe {} with keyframe {} ({} inliers, {} keyframes "
-      "agree, {} landmarks fused, seam correction {:.3f} m)",
+      "agree, {} landmarks fused, {} keyframes welded, seam correction {:.3f} m)",
       from, into, kf_id, loop.candidate, loop.inliers, loop.coincidences, result->fused,
-      result->correction_m);
+      result->welded_keyframes, result->correction_m);
+}
+
+std::set<KeyFrameId> LoopCloser::WeldSeam(Map& map, KeyFrameId kf_id, KeyFrameId candidate,
+                                          const std::set<KeyFrameId>& moved) {
+  const size_t side = static_cast<size_t>(options_.merge_weld_keyframes);
+  if (side == 0) return {};
+  // Each side: its seam keyframe and best covisibles of its own map (after the fusion the best
+  // covisibles may reach across the seam).
+  auto side_of = [&](KeyFrameId seam, bool in_moved) {
+    std::vector<KeyFrameId> out = {seam};
+    for (KeyFrameId c : map.BestCovisibles(seam, 1000)) {
+      if (out.size() >= side) break;
+      if ((moved.count(c) > 0) == in_moved) out.push_back(c);
+    }
+    return out;
+  };
+  const bool kf_moved = moved.count(kf_id) > 0;
+  const std::vector<KeyFrameId> adjust = side_of(kf_moved ? kf_id : candidate, true);
+  const std::vector<KeyFrameId> held = side_of(kf_moved ? candidate : kf_id, false);
+  MapBundle bundle = BuildWindowBundle(map, adjust, static_cast<int>(side), held);
+  if (bundle.problem.poses.empty() || bundle.problem.observations.empty()) return {};
+  BundleOptions bo;
+  bo.max_iterations = options_.merge_weld_iterations;
+  const BundleSummary summary = SolveBundle(camera_, &bundle.problem, bo);
+  if (!summary.usable) {
+    spdlog::warn("merge: the seam's bundle adjustment failed; the pose graph alone welds it");
+    return {};
+  }
+  ApplyMapBundle(bundle, summary, &map);
+  std::set<KeyFrameId> optimised;
+  for (const BundleProblem::Pose& p : bundle.problem.poses)
+    if (!p.fixed) optimised.insert(p.id);
+  return optimised;
 }
 
 bool LoopCloser::WithinRadius(const Map& map, KeyFrameId kf_id, KeyFrameId other) const {
@@ -398,7 +435,7 @@ bool LoopCloser::ConfirmPending(const Map& map, KeyFrameId kf_id) {
 }
 
 void LoopCloser::Correct(Map& map, KeyFrameId kf_id, const Verified& loop, bool correct_poses,
-                         LoopClosingResult* result) {
+                         const std::set<KeyFrameId>* moved, LoopClosingResult* result) {
   // Poses and positions before the correction.
   std::map<KeyFrameId, Rigid3d> old_pose;
   for (const auto& [id, k] : map.keyframes()) old_pose[id] = k.cam_from_world;
@@ -449,6 +486,20 @@ void LoopCloser::Correct(Map& map, KeyFrameId kf_id, const Verified& loop, bool 
   for (KeyFrameId g : group) map.UpdateConnections(g);
   if (!correct_poses) return;
 
+  // A merge's seam: the moved map's side is bundle-adjusted against the kept map now, and the pose
+  // graph, with that window and the kept map fixed, bends the rest of the moved map to it. The
+  // landmarks then move with their reference keyframes from the poses and positions after the
+  // weld (`moved_from`); the edges keep the relative poses from before it.
+  std::map<KeyFrameId, Rigid3d> moved_from = old_pose;
+  const std::set<KeyFrameId> welded =
+      moved ? WeldSeam(map, kf_id, loop.candidate, *moved) : std::set<KeyFrameId>{};
+  for (KeyFrameId k : welded) initial[k] = moved_from[k] = map.keyframe(k).cam_from_world;
+  if (!welded.empty()) {
+    for (auto& [id, pos] : old_position)
+      if (map.HasLandmark(id)) pos = map.landmark(id).position;
+  }
+  result->welded_keyframes = static_cast<int>(welded.size());
+
   // Essential graph: spanning tree, strong covisibility, and the new loop connections.
   PoseGraphProblem problem;
   std::map<KeyFrameId, size_t> node;
@@ -459,7 +510,7 @@ void LoopCloser::Correct(Map& map, KeyFrameId kf_id, const Verified& loop, bool 
     PoseGraphProblem::Node n;
     n.id = id;
     n.cam_from_world = initial.at(id);
-    n.fixed = map.IsMapRoot(id);
+    n.fixed = map.IsMapRoot(id) || welded.count(id) > 0 || (!welded.empty() && !moved->count(id));
     problem.nodes.push_back(n);
   }
   std::set<std::pair<KeyFrameId, KeyFrameId>> added;
@@ -497,12 +548,12 @@ void LoopCloser::Correct(Map& map, KeyFrameId kf_id, const Verified& loop, bool 
     if (!map.HasLandmark(id)) continue;
     Landmark& lm = map.landmark(id);
     KeyFrameId ref = lm.reference_keyframe;
-    if (!map.HasKeyFrame(ref) || !old_pose.count(ref)) {
+    if (!map.HasKeyFrame(ref) || !moved_from.count(ref)) {
       if (lm.observations.empty()) continue;
       ref = lm.observations.begin()->first;
     }
-    if (!old_pose.count(ref)) continue;
-    lm.position = map.keyframe(ref).cam_from_world.Inverse() * (old_pose.at(ref) * pos);
+    if (!moved_from.count(ref)) continue;
+    lm.position = map.keyframe(ref).cam_from_world.Inverse() * (moved_from.at(ref) * pos);
     map.UpdateLandmarkGeometry(id);
   }
   result->correction_m =

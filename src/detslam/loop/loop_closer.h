@@ -26,6 +26,7 @@
 #include <functional>
 #include <map>
 #include <optional>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -57,6 +58,14 @@ struct LoopClosingOptions {
   int min_ransac_inliers = 30;
   int min_verified_inliers = 80;   // pose-only inliers after the projection search
   int essential_min_weight = 100;  // covisibility edges kept in the pose graph
+  // A merge is welded (ORB-SLAM3's MergeLocal): after the fusion, a bundle adjustment of the
+  // moved map's side of the seam (its seam keyframe and best covisibles of the same map, up to this
+  // many) against the kept map's side (its seam keyframe and best covisibles, as many, and the
+  // other keyframes that observe the window's points most) held fixed; then the pose graph over the
+  // moved map only, with that window fixed. 0: no welding window (the pose graph over the merged
+  // map, as for a loop).
+  int merge_weld_keyframes = 15;
+  int merge_weld_iterations = 10;  // its Levenberg-Marquardt iterations
   int global_ba_iterations =
       10;  // bundle adjustment of the whole map after the pose graph (0: none; run by the caller)
   uint64_t seed = 7;  // RANSAC
@@ -74,9 +83,11 @@ struct LoopClosingResult {
   double correction_m = 0;             // how far the keyframe moved
   // The candidate lay in another map of the atlas: the two maps were merged (map `merged_from`
   // moved into map `merged_into`'s frame; the one whose root is older keeps its frame), then
-  // welded like a loop (fusion, pose graph over the merged map). `closed` is set too.
+  // welded (fusion, a bundle adjustment of the moved map's side of the seam, the pose graph over
+  // the moved map with that window fixed). `closed` is set too.
   bool merged = false;
   int merged_from = -1, merged_into = -1;
+  int welded_keyframes = 0;  // keyframes the seam's bundle adjustment optimised
   // Keyframe poses before the correction (cam_from_world), for the tracker and the trajectory.
   std::map<KeyFrameId, Rigid3d> old_poses;
 };
@@ -158,9 +169,16 @@ class LoopCloser {
   // (Map::MergeMapInto), then Correct welds the seam.
   void Merge(Map& map, KeyFrameId kf, Verified loop, LoopClosingResult* result);
   // Fuses the loop side's landmarks into kf's neighbourhood and, with correct_poses, moves the map
-  // (pose graph, landmarks with their reference keyframes).
+  // (pose graph, landmarks with their reference keyframes). `moved` (a merge; may be null): the
+  // keyframes of the map that was moved into the other's frame; with merge_weld_keyframes > 0 its
+  // side of the seam is welded (WeldSeam) and the pose graph moves only the rest of that map.
   void Correct(Map& map, KeyFrameId kf, const Verified& loop, bool correct_poses,
-               LoopClosingResult* result);
+               const std::set<KeyFrameId>* moved, LoopClosingResult* result);
+  // The welding bundle adjustment of a merge between keyframe `kf` and `candidate`, one of them in
+  // `moved`: returns the keyframes it optimised (empty when off, without a gauge or when the
+  // solver failed).
+  std::set<KeyFrameId> WeldSeam(Map& map, KeyFrameId kf, KeyFrameId candidate,
+                                const std::set<KeyFrameId>& moved);
 
   PinholeCamera camera_;
   LoopClosingOptions options_;

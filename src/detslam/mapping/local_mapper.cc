@@ -155,29 +155,7 @@ void LocalMapper::LocalBundleAdjustment(MapStore* store, KeyFrameId current,
     for (KeyFrameId k :
          map.BestCovisibles(current, static_cast<size_t>(options_.max_local_keyframes - 1)))
       local.push_back(k);
-    std::set<KeyFrameId> local_set(local.begin(), local.end());
-    std::vector<LandmarkId> points;
-    std::set<LandmarkId> point_set;
-    for (KeyFrameId k : local) {
-      for (LandmarkId id : map.keyframe(k).landmarks) {
-        if (id != kNoLandmark && point_set.insert(id).second) points.push_back(id);
-      }
-    }
-    std::map<KeyFrameId, int> fixed_counts;
-    for (LandmarkId id : points) {
-      for (const auto& [kf, idx] : map.landmark(id).observations) {
-        (void)idx;
-        if (!local_set.count(kf)) ++fixed_counts[kf];
-      }
-    }
-    std::vector<std::pair<int, KeyFrameId>> fixed_sorted;
-    for (const auto& [kf, n] : fixed_counts) fixed_sorted.emplace_back(-n, kf);
-    std::sort(fixed_sorted.begin(), fixed_sorted.end());
-    std::vector<KeyFrameId> fixed;
-    for (size_t i = 0;
-         i < fixed_sorted.size() && static_cast<int>(i) < options_.max_fixed_keyframes; ++i)
-      fixed.push_back(fixed_sorted[i].second);
-    MapBundle bundle = BuildMapBundle(map, local, fixed);
+    MapBundle bundle = BuildWindowBundle(map, local, options_.max_fixed_keyframes);
     if (bundle.problem.poses.empty())
       return std::nullopt;  // no gauge: ORB-SLAM skips local BA then
     return bundle;

@@ -1,8 +1,10 @@
 #include "detslam/mapping/map_bundle.h"
 
+#include <algorithm>
 #include <map>
 #include <optional>
 #include <set>
+#include <utility>
 
 namespace detslam {
 
@@ -43,6 +45,35 @@ MapBundle BuildMapBundle(const Map& map, const std::vector<KeyFrameId>& free,
     }
   }
   return b;
+}
+
+MapBundle BuildWindowBundle(const Map& map, const std::vector<KeyFrameId>& window, int max_fixed,
+                            const std::vector<KeyFrameId>& held) {
+  std::set<KeyFrameId> not_counted(window.begin(), window.end());  // the window and `held`
+  not_counted.insert(held.begin(), held.end());
+  std::vector<LandmarkId> points;
+  std::set<LandmarkId> point_set;
+  for (KeyFrameId k : window) {
+    for (LandmarkId id : map.keyframe(k).landmarks) {
+      if (id != kNoLandmark && point_set.insert(id).second) points.push_back(id);
+    }
+  }
+  std::map<KeyFrameId, int> fixed_counts;
+  for (LandmarkId id : points) {
+    for (const auto& [kf, idx] : map.landmark(id).observations) {
+      (void)idx;
+      if (!not_counted.count(kf)) ++fixed_counts[kf];
+    }
+  }
+  std::vector<std::pair<int, KeyFrameId>> fixed_sorted;
+  for (const auto& [kf, n] : fixed_counts) fixed_sorted.emplace_back(-n, kf);
+  std::sort(fixed_sorted.begin(), fixed_sorted.end());
+  std::vector<KeyFrameId> fixed;
+  for (KeyFrameId k : held)
+    if (std::find(window.begin(), window.end(), k) == window.end()) fixed.push_back(k);
+  for (size_t i = 0; i < fixed_sorted.size() && static_cast<int>(i) < max_fixed; ++i)
+    fixed.push_back(fixed_sorted[i].second);
+  return BuildMapBundle(map, window, fixed);
 }
 
 int ApplyMapBundle(const MapBundle& bundle, const BundleSummary& summary, Map* map) {

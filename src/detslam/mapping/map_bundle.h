@@ -27,6 +27,13 @@ struct MapBundle {
 MapBundle BuildMapBundle(const Map& map, const std::vector<KeyFrameId>& free,
                          const std::vector<KeyFrameId>& fixed);
 
+// A local window: `window` optimised (except a map root), `held` (outside it) held fixed, and the
+// other keyframes that observe the window's landmarks most (up to `max_fixed`, ties by id) held
+// fixed too (ORB-SLAM's local bundle adjustment; a merge's welding window against the kept map's
+// side). Empty when nothing would be fixed (no gauge).
+MapBundle BuildWindowBundle(const Map& map, const std::vector<KeyFrameId>& window, int max_fixed,
+                            const std::vector<KeyFrameId>& held = {});
+
 // Writes a solved bundle back: erases the observations the solver marked as outliers, sets the
 // free poses and the points (updating their geometry). Keyframes or landmarks removed meanwhile
 // are skipped. Returns the number of observations erased.

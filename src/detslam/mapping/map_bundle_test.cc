@@ -70,6 +70,49 @@ TEST(PropagateBundleCorrection, NewcomersMoveWithTheirParentAndReference) {
   EXPECT_NEAR(map.keyframe(k0).Center().y(), 0.0, 1e-12);         // the anchor stays
 }
 
+// A window's bundle: the window optimised, the keyframes the caller holds and those outside it that
+// see its landmarks most held fixed (as many as allowed), and no bundle when nothing anchors it.
+TEST(BuildWindowBundle, FixesTheKeyFramesThatSeeTheWindowsPointsMost) {
+  Map map(ScaleInfo::Geometric(1.2, 8));
+  const KeyFrameId k0 = AddKeyFrameAt(&map, 0.0);  // the map's root
+  const KeyFrameId k1 = AddKeyFrameAt(&map, 1.0);
+  const KeyFrameId k2 = AddKeyFrameAt(&map, 2.0);
+  const KeyFrameId k3 = AddKeyFrameAt(&map, 3.0);
+  const LandmarkId a = map.AddLandmark(Eigen::Vector3d(1, 0, 2), k1);
+  const LandmarkId b = map.AddLandmark(Eigen::Vector3d(2, 0, 2), k1);
+  const LandmarkId only_outside = map.AddLandmark(Eigen::Vector3d(0, 0, 2), k0);
+  for (KeyFrameId k : {k1, k2, k3}) {
+    map.AddObservation(a, k, 0);
+    map.AddObservation(b, k, 1);
+  }
+  map.AddObservation(b, k0, 0);             // k0 sees one of the window's points, k3 two
+  map.AddObservation(only_outside, k0, 1);  // seen by no keyframe of the window
+  auto poses = [](const MapBundle& m) {
+    std::vector<std::pair<KeyFrameId, bool>> out;
+    for (const BundleProblem::Pose& p : m.problem.poses) out.emplace_back(p.id, p.fixed);
+    return out;
+  };
+  using Poses = std::vector<std::pair<KeyFrameId, bool>>;
+
+  const MapBundle one = BuildWindowBundle(map, {k1, k2}, 1);
+  EXPECT_EQ(poses(one), (Poses{{k1, false}, {k2, false}, {k3, true}}));
+  ASSERT_EQ(one.problem.points.size(), 2u);  // a and b, not the point seen only outside
+  EXPECT_EQ(one.problem.observations.size(), 6u);
+
+  const MapBundle all = BuildWindowBundle(map, {k1, k2}, 5);
+  EXPECT_EQ(poses(all), (Poses{{k1, false}, {k2, false}, {k3, true}, {k0, true}}));
+  EXPECT_EQ(all.problem.observations.size(), 7u);  // b in k0 too
+
+  // No keyframe fixed and no map root in the window: no gauge, no bundle.
+  EXPECT_TRUE(BuildWindowBundle(map, {k1, k2}, 0).problem.poses.empty());
+  // The map's root in the window anchors it.
+  EXPECT_EQ(poses(BuildWindowBundle(map, {k0, k1}, 0)), (Poses{{k0, true}, {k1, false}}));
+  // Keyframes held by the caller come first among the fixed ones and are not counted again.
+  EXPECT_EQ(poses(BuildWindowBundle(map, {k1}, 0, {k2})), (Poses{{k1, false}, {k2, true}}));
+  EXPECT_EQ(poses(BuildWindowBundle(map, {k1}, 1, {k2})),
+            (Poses{{k1, false}, {k2, true}, {k3, true}}));
+}
+
 // Three keyframes that see the same 40 points; the landmarks are perturbed so that the bundle has
 // something to do. Returns the store.
 void FillNoisyMap(const PinholeCamera& camera, Map* map) {

@@ -171,6 +171,7 @@ void WriteRunOutputs(const RgbdSource& dataset, const Settings& settings, const 
                      {"agreeing_keyframes", r.agreeing},
                      {"correction_m", r.correction_m},
                      {"merge", r.merge},
+                     {"welded_keyframes", r.welded_keyframes},
                      {"corrected_after_frame", r.corrected_after_frame},
                      {"map_locked_ms", r.map_locked_ms}});
   }

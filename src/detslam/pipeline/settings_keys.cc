@@ -106,6 +106,8 @@ std::vector<Binding> MakeBindings() {
   k.push_back(Key("LoopClosing.ConsistentDetections", 1, kInf, "loops found by appearance: keyframes that must agree (the verifying one, its covisibles, the next ones)", [](auto& r) -> auto& { return r.run.slam.loop.consistent_detections; }));
   k.push_back(Key("Place.Vocabulary", "bag-of-words vocabulary file for relocalisation and loop detection (empty: the shipped one; none: no place recognition) (--vocabulary)", [](auto& r) -> auto& { return r.run.slam.vocabulary; }));
   k.push_back(Key("LoopClosing.GlobalBAIterations", 0, kInf, "global bundle adjustment iterations after a loop (0: none)", [](auto& r) -> auto& { return r.run.slam.loop.global_ba_iterations; }));
+  k.push_back(Key("LoopClosing.MergeWeldKeyFrames", 0, kInf, "a merge's welding window: keyframes on each side of the seam bundle-adjusted, then fixed in the pose graph (0: the pose graph alone)", [](auto& r) -> auto& { return r.run.slam.loop.merge_weld_keyframes; }));
+  k.push_back(Key("LoopClosing.MergeWeldIterations", 1, kInf, "iterations of a merge's welding bundle adjustment", [](auto& r) -> auto& { return r.run.slam.loop.merge_weld_iterations; }));
   // Det-SLAM dynamic filter.
   k.push_back(Key("Dynamic.Classes", "class names treated as dynamic (comma-separated); the segmenter returns only these", [](auto& r) -> auto& { return r.run.slam.dynamic.filter.dynamic_classes; })
                   .Also([](auto& r) -> auto& { return r.segmenter.dnn.classes; })

@@ -125,7 +125,7 @@ void SlamSystem::MapKeyFrame(KeyFrameId kf, FrameReport* report) {
     loops_.push_back({map.keyframe(loop.keyframe).frame_index, loop.keyframe, loop.candidate,
                       report->loop_candidate_frame, loop.inliers, loop.agreeing,
                       loop.correction_m, loop.merged, loop.merged_from, loop.merged_into,
-                      last_tracked_frame_, 0.0});
+                      loop.welded_keyframes, last_tracked_frame_, 0.0});
     ++loop_generation_;
     global_ba = options_.loop.global_ba_iterations > 0 && !interrupted_;
   };

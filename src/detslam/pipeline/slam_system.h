@@ -57,6 +57,7 @@ struct LoopRecord {
   double correction_m = 0;             // how far the pose graph moved the keyframe
   bool merge = false;                  // the candidate was in another map: two maps merged
   int merged_from = -1, merged_into = -1;
+  int welded_keyframes = 0;  // a merge: keyframes its seam's bundle adjustment optimised
   // When the correction was applied: the newest input frame tracked by then (a mapping thread
   // corrects some frames after the keyframe's), and the longest time loop closing held the map's
   // lock in one step for this keyframe (candidate search, one candidate's verification, or the
