@@ -23,6 +23,16 @@ bool PinholeCamera::Check(std::string* error) const {
   return os.str().empty();
 }
 
+Eigen::Vector2d PinholeCamera::Distort(const Eigen::Vector2d& undistorted) const {
+  if (!HasDistortion()) return undistorted;
+  const double x = (undistorted.x() - cx) / fx, y = (undistorted.y() - cy) / fy;
+  const double r2 = x * x + y * y;
+  const double radial = 1 + r2 * (k1 + r2 * (k2 + r2 * k3));
+  const double xd = x * radial + 2 * p1 * x * y + p2 * (r2 + 2 * x * x);
+  const double yd = y * radial + p1 * (r2 + 2 * y * y) + 2 * p2 * x * y;
+  return {fx * xd + cx, fy * yd + cy};
+}
+
 std::vector<Eigen::Vector2d> PinholeCamera::Undistort(
     const std::vector<Eigen::Vector2d>& distorted) const {
   if (!HasDistortion() || distorted.empty()) return distorted;

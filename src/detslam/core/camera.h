@@ -50,6 +50,9 @@ struct PinholeCamera {
     return uv.x() >= border && uv.y() >= border && uv.x() < width - border &&
            uv.y() < height - border;
   }
+  // Applies lens distortion to undistorted pixel coordinates (the Brown-Conrady model OpenCV
+  // uses; identity without distortion): where an undistorted projection lies in the image.
+  Eigen::Vector2d Distort(const Eigen::Vector2d& undistorted) const;
   // Removes lens distortion from pixel coordinates (identity without distortion).
   std::vector<Eigen::Vector2d> Undistort(const std::vector<Eigen::Vector2d>& distorted) const;
 };

@@ -92,16 +92,19 @@ LabelledKeypoints DetSlamStage::Extract(const OrbExtractor& extractor, const cv:
   if (instances != nullptr) {
     regions = DynamicRegions::Build(*instances, depth_m, gray.size(), options_.filter);
   }
-  cv::Mat mask = ignore_mask;
-  if (instances != nullptr && options_.premask && !instances->empty()) {
-    const cv::Mat dynamic = regions.IgnoreMask(depth_m);
-    if (mask.empty()) {
-      mask = dynamic;
+  cv::Mat withheld = ignore_mask;
+  if (instances != nullptr && !instances->empty()) {
+    cv::Mat dynamic = regions.IgnoreMask(depth_m);
+    if (ignore_mask.empty()) {
+      withheld = std::move(dynamic);
     } else {
-      cv::bitwise_or(mask, dynamic, mask);
+      withheld = cv::Mat();  // a new buffer: the caller's mask stays as it was
+      cv::bitwise_or(ignore_mask, dynamic, withheld);
     }
   }
-  extractor.Extract(gray, mask, &out.keypoints, &out.descriptors);
+  extractor.Extract(gray, options_.premask ? withheld : ignore_mask, &out.keypoints,
+                    &out.descriptors);
+  out.withheld = withheld;
   out.depth = SampleKeypointDepth(out.keypoints, depth_m);
   out.labels.assign(out.keypoints.size(), KeypointLabel::kStatic);
   if (instances != nullptr) {

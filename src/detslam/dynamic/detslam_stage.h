@@ -61,6 +61,9 @@ struct LabelledKeypoints {
   std::vector<float> depth;           // per keypoint (SampleKeypointDepth), <= 0 unknown
   std::vector<KeypointLabel> labels;  // per keypoint: kStatic, kDynamicMask or kDynamicDepth
   int instances_used = 0;             // dynamic instances the filter used
+  // CV_8UC1, non-zero where keypoints are withheld (the ignore mask and the dynamic regions, as
+  // Label decides them); empty when nothing is.
+  cv::Mat withheld;
 };
 
 class DetSlamStage {

@@ -4,6 +4,9 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "detslam/features/orb_extractor.h"
+#include "detslam/features/texture_for_test.h"
+
 namespace detslam {
 namespace {
 
@@ -79,6 +82,50 @@ TEST(DetSlamStageTest, AnUnusedInstanceIsNotRememberedWhenItDisappears) {
   stage.Segment(Input(0), gray);
   const std::vector<std::string> person = {"person@10"};
   EXPECT_EQ(Names(stage.Segment(Input(1), gray).instances), person);
+}
+
+TEST(DetSlamStageTest, ExtractionReportsWhereKeypointsWereWithheld) {
+  const cv::Mat gray = testing::MakeTexture(320, 240, 7);
+  const cv::Mat depth(240, 320, CV_32FC1, cv::Scalar(2.0f));
+  Instance person;
+  person.class_name = "person";
+  person.class_id = 0;
+  person.score = 0.9f;
+  person.box = {100, 60, 60, 120};
+  person.mask = cv::Mat::zeros(240, 320, CV_8UC1);
+  person.mask(person.box).setTo(255);
+  cv::Mat ignore = cv::Mat::zeros(240, 320, CV_8UC1);
+  ignore(cv::Rect(0, 0, 20, 20)).setTo(255);
+  const cv::Mat ignore_before = ignore.clone();
+  OrbOptions orb;
+  orb.num_features = 500;
+  const OrbExtractor extractor(orb);
+  for (const bool premask : {true, false}) {
+    DetSlamOptions options;
+    options.premask = premask;
+    const DetSlamStage stage(options, nullptr);
+    const std::vector<Instance> instances{person};
+    const LabelledKeypoints out = stage.Extract(extractor, gray, depth, ignore, &instances);
+    ASSERT_EQ(out.withheld.size(), gray.size());
+    // The person's (dilated) mask, the depth step over its box and the ignore mask are withheld;
+    // far from all of them nothing is.
+    EXPECT_NE(out.withheld.at<uint8_t>(120, 130), 0) << premask;
+    EXPECT_NE(out.withheld.at<uint8_t>(60 - 5, 130), 0) << premask;  // within the dilation
+    EXPECT_NE(out.withheld.at<uint8_t>(5, 5), 0) << premask;
+    EXPECT_EQ(out.withheld.at<uint8_t>(200, 290), 0) << premask;
+    // Every keypoint labelled dynamic lies where the mask is set, every static one where not.
+    for (size_t i = 0; i < out.keypoints.size(); ++i) {
+      const cv::Point p(static_cast<int>(std::lround(out.keypoints[i].pt.x)),
+                        static_cast<int>(std::lround(out.keypoints[i].pt.y)));
+      EXPECT_EQ(out.labels[i] != KeypointLabel::kStatic, out.withheld.at<uint8_t>(p) != 0)
+          << premask << " " << p;
+    }
+    // The caller's ignore mask is not written into.
+    EXPECT_EQ(cv::countNonZero(ignore != ignore_before), 0) << premask;
+  }
+  // Without instances or an ignore mask nothing is withheld.
+  const DetSlamStage stage(DetSlamOptions{}, nullptr);
+  EXPECT_TRUE(stage.Extract(extractor, gray, depth, cv::Mat(), nullptr).withheld.empty());
 }
 
 }  // namespace

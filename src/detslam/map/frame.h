@@ -76,6 +76,10 @@ struct Frame {
   std::vector<KeypointLabel> labels;
   std::optional<Rigid3d> cam_from_world;
   KeyFrameId reference_keyframe = kNoKeyFrame;
+  // CV_8UC1 in detected (distorted) pixels, non-zero where keypoints were withheld before
+  // tracking (the Det-SLAM stage's dynamic regions, the run's ignore mask); empty: nowhere. A map
+  // point seen there is hidden, not missed (tracking does not count it as visible).
+  cv::Mat withheld;
 
   size_t size() const { return features ? features->size() : 0; }
 };

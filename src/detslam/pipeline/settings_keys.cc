@@ -97,6 +97,8 @@ std::vector<Binding> MakeBindings() {
   std::vector<Binding> k;
   // Tracking, local mapping, loop closing.
   k.push_back(Key("Tracking.KeyFrameFarPoints", 0, kInf, "map points a keyframe creates from depth beyond ThDepth", [](auto& r) -> auto& { return r.run.slam.tracker.keyframe_far_points; }));
+  k.push_back(Key("Tracking.SkipWithheldPoints", "local-map points projecting where keypoints were withheld (people, the ignore mask) are hidden, not missed: not searched, not counted as visible for map-point culling; off: counted as ORB-SLAM3 counts every point in view", [](auto& r) -> auto& { return r.run.slam.tracker.skip_withheld_points; }));
+  k.push_back(Key("Tracking.KeyFramesForWithheld", "the close-point keyframe rule (fewer than 100 close points tracked) with its bound divided by the fraction of the image not withheld (at least 0.3): people hiding the near scene make keyframes come sooner; off: ORB-SLAM3's fixed bound", [](auto& r) -> auto& { return r.run.slam.tracker.keyframes_for_withheld; }));
   k.push_back(Key("Atlas.NewMapWhenLost", "when a frame can be neither tracked nor relocalised, start a new map from it at once (merged later when place recognition finds the overlap); off: stay lost until relocalisation", [](auto& r) -> auto& { return r.run.slam.tracker.new_map_when_lost; }));
   k.push_back(Key("LocalMapping.BundleAdjustment", "local bundle adjustment after each keyframe", [](auto& r) -> auto& { return r.run.slam.mapper.local_ba; }));
   k.push_back(Key("LocalMapping.MaxLocalKeyFrames", 1, kInf, "keyframes optimised by local BA (current + best covisibles)", [](auto& r) -> auto& { return r.run.slam.mapper.max_local_keyframes; }));

@@ -278,6 +278,7 @@ Frame SlamSystem::ExtractFrame(int64_t index, Timestamp stamp, const cv::Mat& gr
   Frame frame;
   frame.index = index;
   frame.stamp = stamp;
+  frame.withheld = std::move(all.withheld);
   auto features = BuildFrameFeatures(camera_, std::move(kept), kept_desc, std::move(kept_depth));
   features->rejected_keypoints = std::move(rejected);
   features->rejected_labels = std::move(rejected_labels);

@@ -38,6 +38,16 @@ struct TrackerOptions {
   double ref_ratio = 0.75;                // thRefRatio (0.4 with one keyframe)
   int close_tracked_max = 100;            // bNeedToInsertClose: tracked close < this
   int close_untracked_min = 70;           //                      and untracked close > this
+  // Local-map points that project where the frame's keypoints were withheld (Frame::withheld:
+  // people, the ignore mask) are hidden there, not missed: they are not searched and do not count
+  // as visible for culling's found ratio. false: counted as ORB-SLAM3 counts every point in the
+  // frustum.
+  bool skip_withheld_points = true;
+  // The close-point keyframe rule (tracked close < close_tracked_max) with the bound divided by
+  // the fraction of the image where keypoints were not withheld (at least 0.3): a person hiding
+  // the near scene leaves fewer close points to track, and then a keyframe is made sooner.
+  // false: ORB-SLAM3's fixed bound.
+  bool keyframes_for_withheld = true;
   // Several maps: when a frame can neither be tracked nor relocalised, start a new map from it at
   // once (RGB-D initialises from one frame), so that no stretch is left without poses; the old
   // maps stay, relocalisation and loop closing search them too, and a verified overlap merges
@@ -134,6 +144,8 @@ class Tracker {
       10;  // projection search widening a relocalisation
   static constexpr double kRelocalizationProjectionRatio = 0.9;
   static constexpr int kMinKeyFrameInliers = 15;  // NeedNewKeyFrame c2: at least this many inliers
+  // keyframes_for_withheld: the visible fraction the close-point bound is divided by, at least.
+  static constexpr double kMinVisibleForCloseRule = 0.3;
   static constexpr int kMaxQueuedKeyFrames = 3;   // ... and, mapping busy, fewer waiting (RGB-D)
   static constexpr double kNewKeyFrameRefRatioOneKf = 0.4;  // thRefRatio with one keyframe
   static constexpr double kNewKeyFrameLowRatio = 0.25;  // c1c: weak tracking against the reference

@@ -2,6 +2,7 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <cmath>
 #include <map>
 #include <set>
 
@@ -12,6 +13,17 @@
 #include "detslam/tracking/tracker.h"
 
 namespace detslam {
+namespace {
+
+// Whether the undistorted pixel `uv` lies where `withheld` (CV_8UC1, detected pixels) is set.
+bool Withheld(const cv::Mat& withheld, const PinholeCamera& camera, const Eigen::Vector2d& uv) {
+  const Eigen::Vector2d d = camera.Distort(uv);
+  const int x = static_cast<int>(std::lround(d.x())), y = static_cast<int>(std::lround(d.y()));
+  if (x < 0 || y < 0 || x >= withheld.cols || y >= withheld.rows) return false;
+  return withheld.at<uint8_t>(y, x) != 0;
+}
+
+}  // namespace
 
 void Tracker::UpdateLocalMap(const Map& map, const Frame& frame) {
   // K1: keyframes that observe the frame's landmarks, with the count of shared landmarks.
@@ -67,15 +79,19 @@ bool Tracker::TrackLocalMap(Map& map, Frame* frame, int* inliers) {
   }
   const Rigid3d& pose = *frame->cam_from_world;
   const Eigen::Vector3d center = pose.Inverse().translation();
+  const bool check_withheld = options_.skip_withheld_points && !frame->withheld.empty();
   for (LandmarkId id : local_landmarks_) {
     if (matched_set_.Contains(id)) continue;
     Landmark& lm = map.landmark(id);
     // Frustum check (counts as "visible" for the found ratio).
     const Eigen::Vector3d pc = pose * lm.position;
-    if (pc.z() <= 0 || !camera_.InImage(camera_.Project(pc))) continue;
+    if (pc.z() <= 0) continue;
+    const Eigen::Vector2d uv = camera_.Project(pc);
+    if (!camera_.InImage(uv)) continue;
     const double dist = (lm.position - center).norm();
     if (dist < 0.8 * lm.min_distance || dist > 1.2 * lm.max_distance) continue;
     if ((lm.position - center).dot(lm.normal) < 0.5 * dist) continue;
+    if (check_withheld && Withheld(frame->withheld, camera_, uv)) continue;
     ++lm.visible;
     candidates.push_back(CandidateFromLandmark(lm));
   }
@@ -208,8 +224,17 @@ bool Tracker::NeedNewKeyFrame(const Map& map, const Frame& frame, int inliers,
       }
     }
   }
+  // ORB-SLAM3's bNeedToInsertClose, its tracked-close bound raised in proportion to the part of
+  // the image where keypoints were withheld (people hiding the near scene leave fewer close points
+  // to track, and a keyframe is wanted sooner; keyframes_for_withheld).
+  double close_tracked_max = options_.close_tracked_max;
+  if (options_.keyframes_for_withheld && !frame.withheld.empty()) {
+    const double visible =
+        1.0 - cv::countNonZero(frame.withheld) / static_cast<double>(frame.withheld.total());
+    close_tracked_max /= std::max(visible, kMinVisibleForCloseRule);
+  }
   const bool need_close =
-      tracked_close < options_.close_tracked_max && untracked_close > options_.close_untracked_min;
+      tracked_close < close_tracked_max && untracked_close > options_.close_untracked_min;
   const double th_ref = num_kfs < 2 ? kNewKeyFrameRefRatioOneKf : options_.ref_ratio;
   const bool c1a = frame.index >= last_keyframe_frame_ + max_frames;
   const bool c1b = mapping.idle;  // always in sequential runs
