@@ -224,17 +224,20 @@ bool Tracker::NeedNewKeyFrame(const Map& map, const Frame& frame, int inliers,
       }
     }
   }
-  // ORB-SLAM3's bNeedToInsertClose, its tracked-close bound raised in proportion to the part of
-  // the image where keypoints were withheld (people hiding the near scene leave fewer close points
-  // to track, and a keyframe is wanted sooner; keyframes_for_withheld).
-  double close_tracked_max = options_.close_tracked_max;
-  if (options_.keyframes_for_withheld && !frame.withheld.empty()) {
+  // ORB-SLAM3's bNeedToInsertClose; with keyframes_for_withheld also its tracked-close bound
+  // divided by the part of the image where keypoints were not withheld (people hiding the near
+  // scene leave fewer close points to track, and a keyframe is wanted sooner), but only while
+  // local mapping is idle: those extra keyframes must not flood a busy mapping thread (at camera
+  // rate they left it mapping in bursts, without fusion or bundle adjustment).
+  const bool need_close_orb =
+      tracked_close < options_.close_tracked_max && untracked_close > options_.close_untracked_min;
+  bool need_close = need_close_orb;
+  if (!need_close && mapping.idle && options_.keyframes_for_withheld && !frame.withheld.empty() &&
+      untracked_close > options_.close_untracked_min) {
     const double visible =
         1.0 - cv::countNonZero(frame.withheld) / static_cast<double>(frame.withheld.total());
-    close_tracked_max /= std::max(visible, kMinVisibleForCloseRule);
+    need_close = tracked_close < options_.close_tracked_max / std::max(visible, kMinVisibleForCloseRule);
   }
-  const bool need_close =
-      tracked_close < close_tracked_max && untracked_close > options_.close_untracked_min;
   const double th_ref = num_kfs < 2 ? kNewKeyFrameRefRatioOneKf : options_.ref_ratio;
   const bool c1a = frame.index >= last_keyframe_frame_ + max_frames;
   const bool c1b = mapping.idle;  // always in sequential runs
