@@ -45,8 +45,8 @@ struct TrackerOptions {
   bool skip_withheld_points = true;
   // The close-point keyframe rule (tracked close < close_tracked_max) with the bound divided by
   // the fraction of the image where keypoints were not withheld (at least 0.3): a person hiding
-  // the near scene leaves fewer close points to track, and then a keyframe is made sooner.
-  // false: ORB-SLAM3's fixed bound.
+  // the near scene leaves fewer close points to track, and then a keyframe is made sooner. Only
+  // while local mapping is idle (always in sequential runs). false: ORB-SLAM3's fixed bound.
   bool keyframes_for_withheld = true;
   // Several maps: when a frame can neither be tracked nor relocalised, start a new map from it at
   // once (RGB-D initialises from one frame), so that no stretch is left without poses; the old
