@@ -10,9 +10,10 @@
 #   gt masks (+ depth step, geometric) : oracle segmentation from the generator
 #   twin and filter, RGBD.DisparitySigma=0: the same with ORB-SLAM3's depth weighting
 # The dnn masks are computed once per sequence with `detslam segment` and replayed (masks:DIR),
-# which comes close to --segmenter dnn but is not bit-identical (walking_xyz tuning seed 1,
-# realistic: 4.80 mm replayed against 4.93 with --segmenter dnn, 2026-12-04; cause not found yet:
-# the masks folder keeps one instance id per pixel, and the scores and boxes as text). The (preset, seed) jobs run JOBS at a time
+# which gives the trajectory of --segmenter dnn byte for byte (the masks folder keeps overlapping
+# masks whole and scores exact; DataSlamDynamic.DnnSegmenterKeepsTheStaticTwinsAccuracy checks it;
+# before 2026-12-05 it kept one instance per pixel: walking_xyz tuning seed 1 gave 4.10 mm
+# replayed against 4.29 live). The (preset, seed) jobs run JOBS at a time
 # (sequential-mode runs are deterministic, so their accuracy does not depend on the load). Then,
 # alone on the machine, segmenting every k-th frame (k = 1, 2, 3, 5) on walking_xyz, the first
 # evaluation seed: accuracy from replayed masks, and the frame rate of the threaded pipeline with
@@ -248,7 +249,9 @@ if [[ "$parts" == *" main "* ]]; then
   echo "filter defaults: alpha = 0.1, mask dilation 15 px, lost detections carried 3 frames (these two"
   echo "were chosen on walking_xyz seed 1, 300 frames), lost detections followed in depth for up to 30"
   echo "frames (Dynamic.DepthTrackFrames, chosen on the tuning seeds), geometric check on. Target: with the filter,"
-  echo "every frame tracked and ATE <= 1.25 x the static twin's (ratio of the unrounded ATEs)."
+  echo "every frame tracked and ATE <= 1.25 x the static twin's (ratio of the unrounded ATEs). The dnn masks"
+  echo "are computed once per sequence (\`detslam segment\`) and replayed (\`masks:DIR\`), which gives the"
+  echo "trajectory of \`--segmenter dnn\` byte for byte."
   echo
   echo "| preset | seed | static twin | with filter (dnn) | ratio | target met | without filter | frames with people detected % | RPE twin / filter |"
   echo "|---|---:|---:|---:|---:|---|---:|---:|---:|"

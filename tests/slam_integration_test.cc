@@ -22,6 +22,7 @@
 #include "detslam/pipeline/runner.h"
 #include "detslam/pipeline/settings_keys.h"
 #include "detslam/place/default_vocabulary.h"
+#include "detslam/segmentation/mask_dir.h"
 #include "detslam/segmentation/segmenter_factory.h"
 #include "detslam/synth/writer.h"
 #include "integration_util.h"
@@ -42,9 +43,30 @@ struct SlamRun {
   std::string trajectory_path;
 };
 
+// Writes what the wrapped segmenter returns into a masks folder (as `detslam segment` does).
+class RecordingSegmenter : public Segmenter {
+ public:
+  RecordingSegmenter(std::unique_ptr<Segmenter> inner, const std::string& dir)
+      : inner_(std::move(inner)), writer_(dir) {}
+  ~RecordingSegmenter() override { writer_.Finish(); }
+  std::vector<Instance> Segment(const SegmenterInput& input) override {
+    std::vector<Instance> found = inner_->Segment(input);
+    writer_.Add(input.stamp, input.bgr.size(), found);
+    return found;
+  }
+  void WarmUp(const SegmenterInput& input) override { inner_->WarmUp(input); }
+  std::string name() const override { return inner_->name(); }
+
+ private:
+  std::unique_ptr<Segmenter> inner_;
+  MaskDirWriter writer_;
+};
+
+// record_masks: a folder to write the segmenter's masks into (empty: none).
 SlamRun RunAndEvaluate(const std::string& dataset_dir, const std::string& out_dir, uint64_t seed,
                        bool threaded = false, const std::string& segmenter_spec = "none",
-                       bool mapping_thread = false, const std::string& models_dir = "") {
+                       bool mapping_thread = false, const std::string& models_dir = "",
+                       const std::string& record_masks = "") {
   const RgbdDataset dataset = RgbdDataset::Open(dataset_dir, {});
   const Settings settings = PresetForDataset(dataset_dir);
   RunOptions options;
@@ -52,10 +74,14 @@ SlamRun RunAndEvaluate(const std::string& dataset_dir, const std::string& out_di
   options.threaded = threaded;
   options.slam = SlamOptionsFromSettings(settings, seed);
   options.mapping_thread = mapping_thread;
-  const std::unique_ptr<Segmenter> segmenter =
+  std::unique_ptr<Segmenter> segmenter =
       MakeSegmenter(segmenter_spec, dataset_dir, ResolveSettings(settings).segmenter, models_dir);
+  if (!record_masks.empty()) {
+    segmenter = std::make_unique<RecordingSegmenter>(std::move(segmenter), record_masks);
+  }
   SlamRun run;
   run.summary = Run(dataset, settings, options, nullptr, segmenter.get());
+  segmenter.reset();  // a recorder writes its instance list
   run.trajectory_path = (fs::path(out_dir) / "trajectory.txt").string();
   run.eval = EvaluateFiles(dataset.groundtruth_path(), run.trajectory_path, dataset_dir, {});
   return run;
@@ -158,8 +184,14 @@ TEST(DataSlamDynamic, DnnSegmenterKeepsTheStaticTwinsAccuracy) {
   so.people = false;
   const std::string twin = TempDir("walking_dnn_twin");
   WriteSequence(so, twin);
+  const std::string masks = TempDir("walking_dnn_masks");
   const SlamRun with_dnn = RunAndEvaluate(seq, TempDir("walking_dnn_run"), 42, false, "dnn", false,
-                                          testing::SharedPath("models"));
+                                          testing::SharedPath("models"), masks);
+  // The benchmarks replay dnn masks written once per sequence (detslam segment, masks:DIR): the
+  // replay must give the live run's trajectory byte for byte (overlapping masks kept whole).
+  const SlamRun replayed = RunAndEvaluate(seq, TempDir("walking_dnn_replay"), 42, false, "masks:" + masks);
+  EXPECT_EQ(ReadFile(replayed.trajectory_path), ReadFile(with_dnn.trajectory_path))
+      << "replayed masks do not give the live dnn run's trajectory";
   const SlamRun without = RunAndEvaluate(seq, TempDir("walking_dnn_none"), 42, false, "none");
   const SlamRun static_twin = RunAndEvaluate(twin, TempDir("walking_dnn_twin_run"), 42);
   EXPECT_EQ(with_dnn.summary.tracked, with_dnn.summary.frames);

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <limits>
 #include <numeric>
 #include <opencv2/imgcodecs.hpp>
 #include <set>
@@ -86,6 +87,10 @@ std::string MaskPngPath(const std::string& dir, Timestamp stamp) {
   return (fs::path(dir) / (stamp.ToString() + ".png")).string();
 }
 
+std::string InstanceMaskPngPath(const std::string& dir, Timestamp stamp, int id) {
+  return (fs::path(dir) / (stamp.ToString() + "_" + std::to_string(id) + ".png")).string();
+}
+
 MaskDirSegmenter::MaskDirSegmenter(const std::string& dir, const std::string& name)
     : dir_(dir), name_(name) {
   if (!fs::is_directory(dir)) throw InputError(dir, 0, "masks folder does not exist");
@@ -128,7 +133,19 @@ std::vector<Instance> MaskDirSegmenter::Segment(const SegmenterInput& input) {
       in.class_name = r.class_name;
       in.score = r.score;
       in.box = size.area() > 0 ? (r.box & image) : r.box;
-      if (has_png) in.mask = (ids == r.id);
+      const std::string own = InstanceMaskPngPath(dir_, input.stamp, r.id);
+      if (fs::exists(own)) {
+        cv::Mat m = cv::imread(own, cv::IMREAD_UNCHANGED);
+        if (m.empty()) throw InputError(own, 0, "cannot decode instance mask image");
+        if (m.type() != CV_8UC1) throw InputError(own, 0, "instance mask must be 8-bit single channel");
+        if (size.area() > 0 && m.size() != size) {
+          throw InputError(own, 0, "instance mask is " + std::to_string(m.cols) + "x" +
+                                       std::to_string(m.rows) + ", not the image's size");
+        }
+        in.mask = (m > 0);
+      } else if (has_png) {
+        in.mask = (ids == r.id);
+      }
       listed.insert(r.id);
       out.push_back(std::move(in));
     }
@@ -185,13 +202,30 @@ void MaskDirWriter::Add(Timestamp stamp, const cv::Size& size,
       ids.setTo(id, in.mask);
     }
   }
-  std::vector<uint8_t> png;
-  const std::string path = MaskPngPath(dir_, stamp);
-  if (!cv::imencode(".png", ids, png)) throw InputError(path, 0, "cannot encode mask PNG");
-  WriteBytesAtomically(path, std::string(png.begin(), png.end()));
+  auto write_png = [](const std::string& path, const cv::Mat& image) {
+    std::vector<uint8_t> png;
+    if (!cv::imencode(".png", image, png)) throw InputError(path, 0, "cannot encode mask PNG");
+    WriteBytesAtomically(path, std::string(png.begin(), png.end()));
+  };
+  write_png(MaskPngPath(dir_, stamp), ids);
+  // A mask the id image does not hold exactly (pixels another instance won) gets its own file.
+  for (size_t k = 0; k < instances.size(); ++k) {
+    cv::Mat own;
+    if (instances[k].mask.empty()) {
+      own = cv::Mat(size, CV_8UC1, cv::Scalar(0));
+      own(instances[k].box & image).setTo(255);
+    } else {
+      own = instances[k].mask > 0;
+    }
+    const cv::Mat kept = ids == static_cast<int>(k + 1);
+    if (cv::countNonZero(own != kept) > 0) {
+      write_png(InstanceMaskPngPath(dir_, stamp, static_cast<int>(k + 1)), own);
+    }
+  }
   for (size_t k = 0; k < instances.size(); ++k) {
     const Instance& in = instances[k];
     std::ostringstream os;
+    os.precision(std::numeric_limits<float>::max_digits10);  // scores read back bit-exact
     os << stamp.ToString() << " " << k + 1 << " " << in.class_id << " "
        << NameToField(in.class_name) << " " << in.score << " " << in.box.x << " " << in.box.y << " "
        << in.box.width << " " << in.box.height;

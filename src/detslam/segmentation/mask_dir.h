@@ -7,6 +7,10 @@
 //                      timestamp with 6 decimals (TUM style, e.g. 1341846313.592026.png);
 //                      8- or 16-bit single channel, the colour image's size; 0 = no object,
 //                      k = pixels of instance k (`detslam segment` writes 16-bit).
+//   DIR/<stamp>_<id>.png optional: the whole mask of instance <id> (8-bit, non-zero = object),
+//                      used instead of the id image's pixels; `detslam segment` writes it for
+//                      masks that overlap another instance's, so that replayed masks are the
+//                      segmenter's own (the id image keeps one instance per pixel).
 //   DIR/instances.txt  one line per instance, '#' comments, fields separated by spaces:
 //                        timestamp id class_id class_name score x y w h
 //                      timestamp: colour stamp (as in the PNG name); id: the instance's value in
@@ -45,6 +49,8 @@ std::map<int64_t, std::vector<MaskRecord>> ReadInstanceList(const std::string& p
 
 // Path of the mask PNG of a frame: DIR/<stamp with 6 decimals>.png.
 std::string MaskPngPath(const std::string& dir, Timestamp stamp);
+// Path of one instance's own mask PNG: DIR/<stamp with 6 decimals>_<id>.png.
+std::string InstanceMaskPngPath(const std::string& dir, Timestamp stamp, int id);
 
 class MaskDirSegmenter : public Segmenter {
  public:
@@ -69,8 +75,10 @@ class MaskDirWriter {
  public:
   // Creates DIR if needed (InputError if impossible). `header` goes into instances.txt comments.
   explicit MaskDirWriter(const std::string& dir, const std::string& header = "");
-  // Instance k (0-based) gets id k + 1; where masks overlap the higher-score instance wins.
-  // Instances with an empty mask are written as their box. Masks must be `size` CV_8UC1.
+  // Instance k (0-based) gets id k + 1; where masks overlap the higher-score instance wins the
+  // id image's pixel and the other masks are written whole to their own files, so that reading
+  // the folder back gives every mask and score exactly. Instances with an empty mask are written
+  // as their box (read back as a box-shaped mask). Masks must be `size` CV_8UC1.
   void Add(Timestamp stamp, const cv::Size& size, const std::vector<Instance>& instances);
   void Flush();
   void Finish() { Flush(); }

@@ -104,10 +104,56 @@ TEST_F(MaskDirTest, HigherScoreWinsWhereMasksOverlap) {
       MakeInstance(0, "person", 0.4f, cv::Rect(0, 0, 30, 30), size, false),
       MakeInstance(0, "person", 0.8f, cv::Rect(20, 0, 30, 30), size, false)};
   WriteMasks(dir_.string(), {t}, {in}, size);
+  const cv::Mat ids = cv::imread(MaskPngPath(dir_.string(), t), cv::IMREAD_UNCHANGED);
+  EXPECT_EQ(cv::countNonZero(ids == 1), 20 * 30);
+  EXPECT_EQ(cv::countNonZero(ids == 2), 30 * 30);
+  EXPECT_TRUE(fs::exists(InstanceMaskPngPath(dir_.string(), t, 1))) << "the loser keeps its mask";
+  EXPECT_FALSE(fs::exists(InstanceMaskPngPath(dir_.string(), t, 2)));
   const auto got = MaskDirSegmenter(dir_.string()).Segment(Frame(t.ToString()));
   ASSERT_EQ(got.size(), 2u);
-  EXPECT_EQ(cv::countNonZero(got[0].mask), 20 * 30);
+  EXPECT_EQ(cv::countNonZero(got[0].mask), 30 * 30);
+  EXPECT_EQ(cv::countNonZero(got[0].mask(cv::Rect(20, 0, 10, 30))), 10 * 30);
   EXPECT_EQ(cv::countNonZero(got[1].mask), 30 * 30);
+}
+
+// What `detslam segment` writes and `masks:DIR` replays must be the segmenter's own output:
+// overlapping masks whole, scores to the last bit (the benchmarks replay dnn masks).
+TEST_F(MaskDirTest, OverlappingMasksAndScoresReadBackExactly) {
+  const cv::Size size(64, 48);
+  const Timestamp t{1000000000};
+  std::vector<Instance> in = {
+      MakeInstance(0, "person", 0.123456791f, cv::Rect(0, 0, 40, 40), size, true),
+      MakeInstance(0, "person", 0.987654328f, cv::Rect(25, 5, 30, 40), size, true),
+      MakeInstance(0, "person", 0.5f, cv::Rect(10, 10, 10, 10), size, true)};  // inside both
+  in[1].mask.at<uint8_t>(47, 0) = 1;  // any non-zero value is object
+  WriteMasks(dir_.string(), {t}, {in}, size);
+  const auto got = MaskDirSegmenter(dir_.string()).Segment(Frame(t.ToString()));
+  ASSERT_EQ(got.size(), in.size());
+  for (size_t k = 0; k < in.size(); ++k) {
+    EXPECT_EQ(got[k].score, in[k].score) << "instance " << k;
+    EXPECT_EQ(cv::countNonZero((got[k].mask != 0) != (in[k].mask != 0)), 0) << "instance " << k;
+  }
+}
+
+TEST_F(MaskDirTest, BadInstanceMaskPngsAreNamed) {
+  WriteList("1.0 1 0 person 0.5 0 0 8 8\n");
+  const Timestamp t{1000000000};
+  const std::string own = InstanceMaskPngPath(dir_.string(), t, 1);
+  ASSERT_TRUE(cv::imwrite(own, cv::Mat(40, 64, CV_8UC1, cv::Scalar(255))));
+  MaskDirSegmenter seg(dir_.string());
+  std::string e = ErrorOf([&] { seg.Segment(Frame("1.0")); });
+  EXPECT_NE(e.find(own), std::string::npos) << e;
+  EXPECT_NE(e.find("64x40"), std::string::npos) << e;
+  ASSERT_TRUE(cv::imwrite(own, cv::Mat(48, 64, CV_16UC1, cv::Scalar(1))));
+  e = ErrorOf([&] { seg.Segment(Frame("1.0")); });
+  EXPECT_NE(e.find("8-bit"), std::string::npos) << e;
+  std::ofstream(own) << "not a png";
+  e = ErrorOf([&] { seg.Segment(Frame("1.0")); });
+  EXPECT_NE(e.find(own), std::string::npos) << e;
+  ASSERT_TRUE(cv::imwrite(own, cv::Mat(48, 64, CV_8UC1, cv::Scalar(0))));
+  const auto got = seg.Segment(Frame("1.0"));
+  ASSERT_EQ(got.size(), 1u);
+  EXPECT_EQ(cv::countNonZero(got[0].mask), 0) << "the own file wins over the (absent) id image";
 }
 
 TEST_F(MaskDirTest, ReadsTheSynthGeneratorsEightFieldLines) {
