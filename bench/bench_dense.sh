@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # Dense static map benchmark on the synthetic walking presets (people textured with the real TUM
 # cut-outs so that the real detector fires on them). Per preset and seed: generate the sequence,
-# segment it with the default dnn segmenter (`detslam segment`, replayed as masks:DIR: close to
-# --segmenter dnn but not bit-identical, see bench_dynamic.sh), run `detslam run --dense-map` (the live run's own dense map,
+# segment it with the default dnn segmenter (`detslam segment`, replayed as masks:DIR: the same
+# as --segmenter dnn since 2026-12-05, see bench_dynamic.sh; sections written before used masks
+# that lost overlaps), run `detslam run --dense-map` (the live run's own dense map,
 # what a user gets), then `detslam densify` of the same run without the masks (--keep-dynamic)
 # and without free-space carving (--no-carve), and score every cloud against the generator's truth
 # with build/bench/dense_eval (synth/dense_truth.h).
