@@ -229,9 +229,8 @@ bool Tracker::NeedNewKeyFrame(const Map& map, const Frame& frame, int inliers,
   // scene leave fewer close points to track, and a keyframe is wanted sooner), but only while
   // local mapping is idle: those extra keyframes must not flood a busy mapping thread (at camera
   // rate they left it mapping in bursts, without fusion or bundle adjustment).
-  const bool need_close_orb =
+  bool need_close =
       tracked_close < options_.close_tracked_max && untracked_close > options_.close_untracked_min;
-  bool need_close = need_close_orb;
   if (!need_close && mapping.idle && options_.keyframes_for_withheld && !frame.withheld.empty() &&
       untracked_close > options_.close_untracked_min) {
     const double visible =
