@@ -128,7 +128,7 @@ void Run(RunArgs a) {
   const RgbdSource& dataset = *source;
   ApplySettingOverrides(a.overrides, &settings);
   const ResolvedSettings resolved = ResolveSettings(settings);  // rejects bad or unknown keys
-  RunOptions options;
+  RunOptions options = resolved.run;  // the run's own keys (e.g. Segmentation.CameraRate*)
   options.out_dir = a.out;
   options.max_frames = a.max_frames;
   options.save_map = a.save_map;

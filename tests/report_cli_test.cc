@@ -23,11 +23,16 @@ TEST(IntegrationReport, RunThenReportWithAccuracyAndPerFramePlots) {
       RunCli("synth --preset walking_xyz --seed 1 --frames 40 --out '" + seq.string() + "'", log),
       0)
       << ReadFileBytes(log);
+  // The run's own settings keys (RunOptions, not SlamOptions) given with --set reach the run.
   ASSERT_EQ(RunCli("run --dataset '" + seq.string() + "' --segmenter gt --no-progress --out '" +
-                       out.string() + "'",
+                       out.string() + "' --set Segmentation.CameraRateOpenCvThreads=3" +
+                       " --set Segmentation.CameraRateFirstFrameWaits=true",
                    log),
             0)
       << ReadFileBytes(log);
+  const std::string run_json = ReadFileBytes(out / "run.json");
+  EXPECT_THAT(run_json, HasSubstr("\"Segmentation.CameraRateOpenCvThreads\": 3"));
+  EXPECT_THAT(run_json, HasSubstr("\"Segmentation.CameraRateFirstFrameWaits\": true"));
   ASSERT_EQ(RunCli("report --run '" + out.string() + "'", log), 0) << ReadFileBytes(log);
   EXPECT_THAT(ReadFileBytes(log), HasSubstr("report: " + (out / "report.html").string()));
   const std::string html = ReadFileBytes(out / "report.html");

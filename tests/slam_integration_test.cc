@@ -373,9 +373,15 @@ TEST(IntegrationRunner, AsynchronousSegmentationDoesNotHoldTheFramesUp) {
   EXPECT_GT(s.frames, s.frames_segmented) << "the frames waited for the segmenter";
   EXPECT_LT(s.latency.median, kSegmenterMs) << "the frames waited for the segmenter";
   ASSERT_FALSE(s.reports.empty());
+  // The start (RunOptions::first_frame_waits_for_masks): the first frame waits for its own masks
+  // and is tracked; the frames that arrived before them are dropped, not queued behind it.
   EXPECT_EQ(s.reports.front().index, 0);
   EXPECT_EQ(s.reports.front().mask_age, 0) << "the first frame has its own masks";
   EXPECT_GE(s.reports.front().latency_ms, kSegmenterMs);
+  ASSERT_GE(s.reports.size(), 2u);
+  EXPECT_LT(s.reports[1].latency_ms, kSegmenterMs) << "the frames behind the first were queued";
+  EXPECT_GE(s.dropped_frames.size(), static_cast<size_t>(kSegmenterMs / 34 - 1))
+      << "the frames arriving while the first waited were not dropped";
   int64_t previous_source = 0;
   int64_t waiting_since = -1;  // the first deferred frame since the last keyframe
   const DetSlamOptions& dyn = options.slam.dynamic;
@@ -390,10 +396,11 @@ TEST(IntegrationRunner, AsynchronousSegmentationDoesNotHoldTheFramesUp) {
       if (waiting_since < 0) waiting_since = r.index;
       EXPECT_LT(r.index - waiting_since, dyn.keyframe_max_wait) << "frame " << r.index;
     }
-    if (r.keyframe && r.tracking.method != "new map") {  // a new map starts whatever the masks
+    if (r.keyframe) {
       // Masks at most the limit old, or stale ones after waiting keyframe_max_wait frames.
       EXPECT_EQ(r.keyframe_stale_masks, r.mask_age > dyn.keyframe_max_mask_age) << r.index;
-      if (r.keyframe_stale_masks && r.tracking.num_inliers >= dyn.keyframe_defer_min_inliers) {
+      if (r.keyframe_stale_masks && r.tracking.num_inliers >= dyn.keyframe_defer_min_inliers &&
+          r.tracking.method != "new map" && r.tracking.method != "init") {  // a map starts at once
         EXPECT_GE(waiting_since, 0) << "keyframe " << r.index << " made without waiting";
         EXPECT_GE(r.index - waiting_since, dyn.keyframe_max_wait) << "keyframe " << r.index;
       }
@@ -406,6 +413,26 @@ TEST(IntegrationRunner, AsynchronousSegmentationDoesNotHoldTheFramesUp) {
   EXPECT_EQ(j["realtime"]["frames_segmented"].get<size_t>(), s.frames_segmented);
   EXPECT_EQ(j["realtime"]["keyframes_stale_masks"].get<size_t>(), s.keyframes_stale_masks);
   EXPECT_EQ(j["per_frame"][1]["mask_age"].get<int>(), s.reports[1].mask_age);
+}
+
+// RunOptions::first_frame_waits_for_masks off: the first frame is segmented, not tracked; tracking
+// starts with a later frame, its masks carried from the first, without waiting for the detector.
+TEST(IntegrationRunner, FirstFrameCanBeLeftUntracked) {
+#if defined(__SANITIZE_THREAD__) || defined(__SANITIZE_ADDRESS__)
+  constexpr int kSegmenterMs = 600;
+#else
+  constexpr int kSegmenterMs = 300;
+#endif
+  RunOptions options;
+  options.first_frame_waits_for_masks = false;
+  const RunSummary s = RunAtCameraRate("camera_rate_first_untracked", /*async=*/true, kSegmenterMs, &options);
+  ExpectEveryFrameProcessedOrDropped(s, 60);
+  ASSERT_FALSE(s.reports.empty());
+  ASSERT_FALSE(s.dropped_frames.empty());
+  EXPECT_EQ(s.dropped_frames.front(), 0) << "the first frame was processed";
+  EXPECT_GT(s.reports.front().index, 0);
+  EXPECT_EQ(s.reports.front().mask_source, 0);
+  EXPECT_LT(s.reports.front().latency_ms, kSegmenterMs) << "the first frame tracked waited for the detector";
 }
 
 TEST(IntegrationSlamSynthetic, StaticPresetTracksEveryFrameWithinOneCentimetre) {

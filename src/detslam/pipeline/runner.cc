@@ -539,10 +539,18 @@ RunSummary RunThreaded(const RgbdSource& dataset, const Settings& settings,
         [&] { loaded.Close(); });
   }
   // Asynchronous segmentation: hands the frame to the segmentation thread (replacing a frame it
-  // has not taken yet) and gives the frame the newest masks carried to it. The first frame waits
-  // for its own.
-  bool waited_for_first_masks = false;
-  const auto carry_masks = [&](LoadedFrame* f) {
+  // has not taken yet) and gives the frame the newest masks carried to it. Returns false for a
+  // frame not processed (it goes into `not_processed`). The start: the first frame waits for its
+  // own masks; with options.first_frame_waits_for_masks it is processed, and the frames that
+  // arrived before its masks are not (they would queue behind it); without, it is not processed
+  // and the next frame is.
+  std::optional<std::chrono::steady_clock::time_point> first_masks;
+  std::vector<int64_t> not_processed;  // the extraction thread's until Join
+  const auto carry_masks = [&](LoadedFrame* f) -> bool {
+    if (first_masks && options.first_frame_waits_for_masks && f->arrival < *first_masks) {
+      not_processed.push_back(f->index);
+      return false;
+    }
     std::optional<LoadedFrame> replaced;
     // The segmentation thread gets images of its own: cv::Mat's reference count lives in OpenCV's
     // (uninstrumented) library, so buffers shared between threads and released last by another
@@ -553,17 +561,22 @@ RunSummary RunThreaded(const RgbdSource& dataset, const Settings& settings,
     for_segmentation.images.gray = f->images.gray.clone();
     for_segmentation.images.depth_m = f->images.depth_m.clone();
     to_segment.PushDroppingOldest(std::move(for_segmentation), &replaced);
-    if (!waited_for_first_masks) {
-      carrier.WaitFor(f->index);
-      waited_for_first_masks = true;
+    if (!first_masks) {
+      const bool published = carrier.WaitFor(f->index);
+      first_masks = std::chrono::steady_clock::now();
+      if (published && !options.first_frame_waits_for_masks) {
+        not_processed.push_back(f->index);
+        return false;
+      }
     }
     std::optional<CarriedInstances> c = carrier.Carry(f->index, f->images.gray);
-    if (!c) return;  // the segmentation thread stopped before publishing anything
+    if (!c) return true;  // the segmentation thread stopped before publishing anything
     f->instances = std::move(c->instances);
     f->segmented = true;
     f->segmentation_ms = c->carry_ms;
     f->mask_source = c->source;
     f->mask_age = c->age;
+    return true;
   };
   BoundedQueue<LoadedFrame>& extraction_input = async ? camera : loaded;
   stages.Start(
@@ -571,8 +584,8 @@ RunSummary RunThreaded(const RgbdSource& dataset, const Settings& settings,
       [&] {
         while (std::optional<LoadedFrame> f = extraction_input.Pop()) {
           if (StopRequested(options)) break;
+          if (async && f->unreadable.empty() && !carry_masks(&*f)) continue;
           Extracted e;
-          if (async && f->unreadable.empty()) carry_masks(&*f);
           if (!f->unreadable.empty()) {
             e.report = SkippedReport(dataset, *f);
           } else {
@@ -639,6 +652,8 @@ RunSummary RunThreaded(const RgbdSource& dataset, const Settings& settings,
   stages.Join();
   if (options.realtime) {
     const auto end = last_pose.value_or(std::chrono::steady_clock::now());
+    dropped.insert(dropped.end(), not_processed.begin(), not_processed.end());
+    std::sort(dropped.begin(), dropped.end());
     recorder.SetCamera(offered, std::move(dropped),
                        std::chrono::duration<double>(end - camera_start).count());
   }

@@ -35,9 +35,15 @@ struct RunOptions {
   // the newest frame whenever it is free and publishes its instances; no other stage waits for it:
   // each frame uses the newest instances carried to it by the mask propagation (MaskCarrier), with
   // their age in FrameReport::mask_age, and a frame whose masks are older than
-  // slam.dynamic.keyframe_max_mask_age makes no keyframe. Only the first frame waits for its own
-  // masks (the map's first points). false: every processed frame is segmented before extraction.
+  // slam.dynamic.keyframe_max_mask_age makes no keyframe. false: every processed frame is
+  // segmented before extraction.
   bool async_segmentation = true;
+  // Asynchronous segmentation, the start: the map's first points need masks, so the first frame
+  // waits for its own. true: it is then processed, and the frames that arrived before its masks
+  // are dropped instead of queueing behind it (one of them waited for the camera's queue, up to a
+  // frame period); false: the first frame is not processed either, and tracking starts with the
+  // next frame, its masks carried from the first. Chosen on the tuning seeds (README, Options).
+  bool first_frame_waits_for_masks = true;
   // Camera-rate mode: the first frames, up to this many MiB of decoded images, are read and
   // decoded before the camera starts (a camera delivers decoded images; decoding PNG files would
   // take CPU time a live camera does not); later frames are read on time by the camera thread.
@@ -100,7 +106,8 @@ struct RunSummary {
   double map_load_ms = 0;                               // reading and restoring it
   std::vector<LoopRecord> loop_records;
   // Camera-rate mode (RunOptions::realtime): frames the camera offered, the indices of those
-  // dropped because the pipeline was busy, and the latency from a frame's arrival to its pose over
+  // dropped because the pipeline was busy (with asynchronous segmentation also those at the start,
+  // RunOptions::first_frame_waits_for_masks), and the latency from a frame's arrival to its pose over
   // the frames processed (ms; also its 99th percentile).
   size_t offered = 0;
   std::vector<int64_t> dropped_frames;

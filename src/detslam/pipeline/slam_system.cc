@@ -321,7 +321,8 @@ KeyFrameId SlamSystem::TrackFrame(Frame frame, FrameReport* report, Frame* track
     }
   }
   if (map.NumKeyFrames() > kfs_before && new_kf == kNoKeyFrame) {
-    new_kf = tracker_.reference_keyframe();  // a new map's first keyframe
+    new_kf = tracker_.reference_keyframe();  // a new map's first keyframe, whatever its masks' age
+    report->keyframe_stale_masks = report->mask_age > options_.dynamic.keyframe_max_mask_age;
     keyframe_wait_since_ = -1;
   }
   if (new_kf != kNoKeyFrame) ++keyframes_to_map_;

@@ -95,7 +95,8 @@ struct FrameReport {
   // DetSlamOptions::keyframe_max_mask_age: no keyframe was made from it.
   bool keyframe_deferred = false;
   // A keyframe was made from masks older than that limit: tracking had become too weak to wait
-  // (DetSlamOptions::keyframe_defer_min_inliers) or it had waited keyframe_max_wait frames.
+  // (DetSlamOptions::keyframe_defer_min_inliers), it had waited keyframe_max_wait frames, or the
+  // keyframe is a new map's first (a map starts whatever its masks' age).
   bool keyframe_stale_masks = false;
   Timestamp stamp;
   TrackingResult tracking;
