@@ -88,7 +88,7 @@ rows = [json.loads(l) for l in open(sys.argv[1])]
 seeds, frames = sys.argv[2], sys.argv[3]
 print(f"`detslam run --realtime` on synthetic walking sequences (people from the real TUM cut-outs; all "
       f"rows synthetic, `detslam synth --realism {os.environ['realism']}`), evaluation seeds {seeds.replace(' ', ', ')}, {frames} frames at 30 fps each, "
-      "default dnn segmenter (offline: YOLOX input 416, Segmentation.InputSize; camera rate: 320, "
+      "default dnn segmenter (offline: YOLOX input 416, Segmentation.InputSize; camera rate: 256 (320 in runs before 2026-12-05 12:20), "
       "Segmentation.CameraRateInputSize, chosen on the tuning seeds 1-3: fresher masks; one OpenCV thread "
       "at camera rate, Segmentation.CameraRateOpenCvThreads, chosen on the same seeds; see the README), "
       "threaded with the mapping thread. The camera offers each frame at its "

@@ -98,9 +98,9 @@ TEST(DnnOptions, CameraRateUsesItsOwnInputSize) {
   EXPECT_EQ(live.detector, s.detector);
   EXPECT_EQ(DnnOptionsFromSettings(live, "/m").yolox_input_size, 256);
   EXPECT_EQ(DnnOptionsFromSettings(s, "/m").yolox_input_size, 448);
-  // The defaults: 416 offline, 320 at camera rate.
+  // The defaults: 416 offline, 256 at camera rate.
   EXPECT_EQ(SegmenterSettings().dnn.yolox_input_size, 416);
-  EXPECT_EQ(ForCameraRate(SegmenterSettings()).dnn.yolox_input_size, 320);
+  EXPECT_EQ(ForCameraRate(SegmenterSettings()).dnn.yolox_input_size, 256);
 }
 
 TEST(DnnOptions, SecondDetectorDefaultIsOptionalAndExplicitOneIsKept) {

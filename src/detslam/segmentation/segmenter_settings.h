@@ -29,7 +29,7 @@ struct SegmenterSettings {
   // The YOLOX input side in the camera-rate mode (--realtime), in place of dnn.yolox_input_size:
   // a smaller input makes the detector faster and the masks the frames get fresher (see
   // ForCameraRate).
-  int camera_rate_input_size = 320;
+  int camera_rate_input_size = 256;
   MaskRcnnOptions maskrcnn;  // score threshold, classes (its paths are filled from the above)
 
   // The segmenters return only the dynamic classes: Dynamic.Classes sets them with the filter's,
