@@ -274,6 +274,16 @@ class SlowSegmenter : public Segmenter {
 
 // 60 frames of a static 30 fps sequence at camera rate (threaded, mapping thread), with a segmenter
 // that takes `segmenter_ms` per frame; *options: those of the run.
+// A slow segmenter's time per frame for the asynchronous camera-rate tests: `ms`, doubled in
+// sanitized builds (extraction and tracking there are 5-20x slower).
+constexpr int SlowSegmenterMs(int ms) {
+#if defined(__SANITIZE_THREAD__) || defined(__SANITIZE_ADDRESS__)
+  return 2 * ms;
+#else
+  return ms;
+#endif
+}
+
 RunSummary RunAtCameraRate(const std::string& name, bool async, int segmenter_ms, RunOptions* options,
                            int* segmenter_opencv_threads = nullptr) {
   const std::string seq = WriteStaticSequence(name, 1, 60);
@@ -352,11 +362,7 @@ TEST(IntegrationRunner, AsynchronousSegmentationDoesNotHoldTheFramesUp) {
   // A segmenter much slower than a frame's extraction and tracking, also on a loaded machine (CI
   // runs two tests at once; a 100 ms segmenter there saw a median latency of 188 ms) and in
   // sanitized builds (extraction and tracking 5-20x slower).
-#if defined(__SANITIZE_THREAD__) || defined(__SANITIZE_ADDRESS__)
-  constexpr int kSegmenterMs = 1000;
-#else
-  constexpr int kSegmenterMs = 500;
-#endif
+  constexpr int kSegmenterMs = SlowSegmenterMs(500);
   RunOptions options;
   const RunSummary s = RunAtCameraRate("camera_rate_async", /*async=*/true, kSegmenterMs, &options);
   EXPECT_TRUE(s.async_segmentation);
@@ -418,11 +424,7 @@ TEST(IntegrationRunner, AsynchronousSegmentationDoesNotHoldTheFramesUp) {
 // RunOptions::first_frame_waits_for_masks off: the first frame is segmented, not tracked; tracking
 // starts with a later frame, its masks carried from the first, without waiting for the detector.
 TEST(IntegrationRunner, FirstFrameCanBeLeftUntracked) {
-#if defined(__SANITIZE_THREAD__) || defined(__SANITIZE_ADDRESS__)
-  constexpr int kSegmenterMs = 600;
-#else
-  constexpr int kSegmenterMs = 300;
-#endif
+  constexpr int kSegmenterMs = SlowSegmenterMs(300);
   RunOptions options;
   options.first_frame_waits_for_masks = false;
   const RunSummary s = RunAtCameraRate("camera_rate_first_untracked", /*async=*/true, kSegmenterMs, &options);
