@@ -40,9 +40,9 @@ struct RunOptions {
   bool async_segmentation = true;
   // Asynchronous segmentation, the start: the map's first points need masks, so the first frame
   // waits for its own. true: it is then processed, and the frames that arrived before its masks
-  // are dropped instead of queueing behind it (one of them waited for the camera's queue, up to a
-  // frame period); false: the first frame is not processed either, and tracking starts with the
-  // next frame, its masks carried from the first. Chosen on the tuning seeds (README, Options).
+  // are dropped instead of queueing behind it; false: the first frame is not processed either,
+  // and tracking starts with the next frame, its masks carried from the first. Chosen on the
+  // tuning seeds (README, Options).
   bool first_frame_waits_for_masks = true;
   // Camera-rate mode: the first frames, up to this many MiB of decoded images, are read and
   // decoded before the camera starts (a camera delivers decoded images; decoding PNG files would
