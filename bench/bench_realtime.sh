@@ -102,7 +102,7 @@ print(f"`detslam run --realtime` on synthetic walking sequences (people from the
       "run-to-run spread, 3 clearly worse for lack of keyframes; 6 keeps the staleness bound at 0.2 s). The "
       "first frame waits for its own masks and is tracked; the frames that arrived before them are "
       "dropped, not queued behind it (Segmentation.CameraRateFirstFrameWaits; runs of this section "
-      "before 2026-12-05 12:00 queued them). The "
+      "before 2026-12-05 11:00 queued them). The "
       "segmentation and local-mapping threads run at nice 5, so that the frames' path gets the cores "
       "first (on the same tuning seeds: 23.5 -> 26.3 fps, 20 -> 11 % dropped, p99 127 -> 100 ms, ATE "
       "unchanged within the spread; nice 10 for segmentation only or for both did no better). Figures come from "
