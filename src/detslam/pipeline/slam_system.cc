@@ -305,27 +305,29 @@ KeyFrameId SlamSystem::TrackFrame(Frame frame, FrameReport* report, Frame* track
   report->tracking = tracker_.Track(map, &frame, mapping);
   if (report->tracking.interrupt_local_ba) abort_local_ba_ = true;
   KeyFrameId new_kf = kNoKeyFrame;
+  // Asynchronous segmentation: masks carried over more than keyframe_max_mask_age frames.
+  const DetSlamOptions& dyn = options_.dynamic;
+  const bool stale = report->mask_age > dyn.keyframe_max_mask_age;
   if (report->tracking.pose_valid && report->tracking.need_keyframe && !options_.localization) {
-    // Asynchronous segmentation: no new map points from masks carried over too many frames,
-    // unless tracking is getting weak or the keyframe has waited keyframe_max_wait frames.
-    const DetSlamOptions& dyn = options_.dynamic;
-    const bool stale = report->mask_age > dyn.keyframe_max_mask_age;
+    // No new map points from stale masks, unless tracking is getting weak or the keyframe has
+    // waited keyframe_max_wait frames.
     if (stale && keyframe_wait_since_ < 0) keyframe_wait_since_ = report->index;
     if (stale && report->tracking.num_inliers >= dyn.keyframe_defer_min_inliers &&
         report->index - keyframe_wait_since_ < dyn.keyframe_max_wait) {
       report->keyframe_deferred = true;
     } else {
       new_kf = tracker_.CreateKeyFrame(map, &frame);
-      report->keyframe_stale_masks = stale;
       keyframe_wait_since_ = -1;
     }
   }
   if (map.NumKeyFrames() > kfs_before && new_kf == kNoKeyFrame) {
     new_kf = tracker_.reference_keyframe();  // a new map's first keyframe, whatever its masks' age
-    report->keyframe_stale_masks = report->mask_age > options_.dynamic.keyframe_max_mask_age;
     keyframe_wait_since_ = -1;
   }
-  if (new_kf != kNoKeyFrame) ++keyframes_to_map_;
+  if (new_kf != kNoKeyFrame) {
+    ++keyframes_to_map_;
+    report->keyframe_stale_masks = stale;
+  }
   report->timings.tracking_ms = MsSince(t0);
 
   if (report->tracking.pose_valid) {
