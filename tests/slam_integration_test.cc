@@ -272,8 +272,6 @@ class SlowSegmenter : public Segmenter {
   std::atomic<int> opencv_threads_{-1};
 };
 
-// 60 frames of a static 30 fps sequence at camera rate (threaded, mapping thread), with a segmenter
-// that takes `segmenter_ms` per frame; *options: those of the run.
 // A slow segmenter's time per frame for the asynchronous camera-rate tests: `ms`, doubled in
 // sanitized builds (extraction and tracking there are 5-20x slower).
 constexpr int SlowSegmenterMs(int ms) {
@@ -284,6 +282,8 @@ constexpr int SlowSegmenterMs(int ms) {
 #endif
 }
 
+// 60 frames of a static 30 fps sequence at camera rate (threaded, mapping thread), with a segmenter
+// that takes `segmenter_ms` per frame; *options: those of the run.
 RunSummary RunAtCameraRate(const std::string& name, bool async, int segmenter_ms, RunOptions* options,
                            int* segmenter_opencv_threads = nullptr) {
   const std::string seq = WriteStaticSequence(name, 1, 60);
