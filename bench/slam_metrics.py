@@ -12,8 +12,14 @@ Usage:
          new_map_merged_later: in a new map that later merged into the main one) and its position
          error (first poses aligned, as for the drift)
   slam_metrics.py loops run.json groundtruth.txt MAX_M
-      -> prints 'true false': the run's loops split by ground truth (false: the true camera centres
-         of the loop's frame and its candidate's frame are more than MAX_M apart)
+      -> prints 'true false': the run's loops (and merges) split by ground truth: false when the
+         relative pose the loop asserts (run.json `candidate_from_keyframe`: its keyframe's camera
+         in its candidate's camera frame) puts the keyframe's camera more than MAX_M from where
+         ground truth has it in that frame. A true loop errs by the drift between the two views
+         (centimetres); a loop that takes look-alike furnishings for the same ones errs by the
+         distance between them (metres), however far apart or close the two cameras are.
+  slam_metrics.py loop-errors run.json groundtruth.txt
+      -> one line per loop: 'frame candidate_frame error_m' (error_m as for `loops`)
   slam_metrics.py nearest groundtruth.txt ROW
       -> prints 'distance_m angle_deg': how far ground-truth pose ROW (0-based row of the file) is
          from the closest of rows 0..ROW-1, closest by distance + angle / (30 deg per m)
@@ -117,25 +123,44 @@ def kidnap(run_json, gt_path, est_path, jump_frame):
     return -1, -1, "-", -1
 
 
-def loops(run_json, gt_path, max_m):
-    """Loops closed in a run, split by ground truth: false when the true camera centres of the
-    loop's frame and of its candidate's frame are more than max_m apart."""
+def rotate_inverse(q, v):
+    """Rotates v by the inverse of unit quaternion q = (x, y, z, w)."""
+    x, y, z, w = -q[0], -q[1], -q[2], q[3]
+    # v' = v + 2 w (u x v) + 2 u x (u x v), u = (x, y, z)
+    cx = y * v[2] - z * v[1]
+    cy = z * v[0] - x * v[2]
+    cz = x * v[1] - y * v[0]
+    return (v[0] + 2 * (w * cx + y * cz - z * cy),
+            v[1] + 2 * (w * cy + z * cx - x * cz),
+            v[2] + 2 * (w * cz + x * cy - y * cx))
+
+
+def loop_errors(run_json, gt_path):
+    """Per loop of run.json: (frame, candidate_frame, error_m), error_m how far the loop's asserted
+    relative pose puts the keyframe's camera from ground truth's (see `loops`)."""
     with open(run_json) as f:
         run = json.load(f)
     stamp = {r["index"]: r["stamp"] for r in run["per_frame"]}
     gt = read_tum(gt_path)
 
-    def centre(t):
-        return min(gt, key=lambda g: abs(g[0] - t))[1:4]
+    def pose(t):
+        return min(gt, key=lambda g: abs(g[0] - t))[1:8]
 
-    true_n = false_n = 0
+    out = []
     for loop in run["loops"]:
-        d = math.dist(centre(stamp[loop["frame"]]), centre(stamp[loop["candidate_frame"]]))
-        if d > max_m:
-            false_n += 1
-        else:
-            true_n += 1
-    return true_n, false_n
+        kf, cand = pose(stamp[loop["frame"]]), pose(stamp[loop["candidate_frame"]])
+        d = [kf[i] - cand[i] for i in range(3)]
+        true_rel = rotate_inverse(cand[3:7], d)  # the keyframe's centre in the candidate's camera
+        est_rel = loop["candidate_from_keyframe"][0:3]
+        out.append((loop["frame"], loop["candidate_frame"], math.dist(true_rel, est_rel)))
+    return out
+
+
+def loops(run_json, gt_path, max_m):
+    """Loops closed in a run, split by ground truth: (true, false)."""
+    errors = [e for _, _, e in loop_errors(run_json, gt_path)]
+    false_n = sum(1 for e in errors if e > max_m)
+    return len(errors) - false_n, false_n
 
 
 def nearest(gt_path, row):
@@ -158,6 +183,10 @@ def main():
     if len(sys.argv) == 6 and sys.argv[1] == "kidnap":
         print("%d %d %s %.4f" % kidnap(sys.argv[2], sys.argv[3], sys.argv[4], int(sys.argv[5])))
         return
+    if len(sys.argv) == 4 and sys.argv[1] == "loop-errors":
+        for frame, cand, err in loop_errors(sys.argv[2], sys.argv[3]):
+            print("%d %d %.4f" % (frame, cand, err))
+        sys.exit(0)
     if len(sys.argv) == 5 and sys.argv[1] == "loops":
         print("%d %d" % loops(sys.argv[2], sys.argv[3], float(sys.argv[4])))
         return

@@ -121,6 +121,8 @@ void LoopCloser::Close(Map& map, KeyFrameId kf_id, const Verified& loop,
   result->candidate = loop.candidate;
   result->inliers = loop.inliers;
   result->agreeing = std::max(1, loop.coincidences);
+  result->candidate_from_keyframe =
+      map.keyframe(loop.candidate).cam_from_world * loop.cam_from_world.Inverse();
   if (map.MapOf(loop.candidate) != map.MapOf(kf_id)) {
     Merge(map, kf_id, loop, result);
     return;

@@ -81,6 +81,10 @@ struct LoopClosingResult {
   int agreeing = 0;  // keyframes that agreed on it (appearance; 1 for a loop found by position)
   int fused = 0;                       // landmarks merged
   double correction_m = 0;             // how far the keyframe moved
+  // The relative pose the loop asserts: the keyframe's verified pose in the candidate's camera
+  // frame (candidate's cam_from_world before the correction times the verified world_from_cam),
+  // what a benchmark compares with ground truth to tell a true loop from a false one.
+  Rigid3d candidate_from_keyframe;
   // The candidate lay in another map of the atlas: the two maps were merged (map `merged_from`
   // moved into map `merged_into`'s frame; the one whose root is older keeps its frame), then
   // welded (fusion, a bundle adjustment of the moved map's side of the seam, the pose graph over

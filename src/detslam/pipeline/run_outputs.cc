@@ -13,6 +13,12 @@
 namespace detslam {
 namespace {
 
+// A pose as TUM's order: tx ty tz qx qy qz qw.
+nlohmann::json PoseJson(const Rigid3d& pose) {
+  const Eigen::Vector3d& t = pose.translation();
+  const Eigen::Quaterniond& q = pose.rotation();
+  return {t.x(), t.y(), t.z(), q.x(), q.y(), q.z(), q.w()};
+}
 
 nlohmann::json StatsJson(const ErrorStats& s) {
   return {{"count", s.count}, {"median_ms", s.median}, {"mean_ms", s.mean},
@@ -170,6 +176,7 @@ void WriteRunOutputs(const RgbdSource& dataset, const Settings& settings, const 
                      {"inliers", r.inliers},
                      {"agreeing_keyframes", r.agreeing},
                      {"correction_m", r.correction_m},
+                     {"candidate_from_keyframe", PoseJson(r.candidate_from_keyframe)},
                      {"merge", r.merge},
                      {"welded_keyframes", r.welded_keyframes},
                      {"corrected_after_frame", r.corrected_after_frame},

@@ -122,10 +122,21 @@ void SlamSystem::MapKeyFrame(KeyFrameId kf, FrameReport* report) {
     report->loop_agreeing = loop.agreeing;
     report->loop_correction_m = loop.correction_m;
     report->maps_merged = loop.merged;
-    loops_.push_back({map.keyframe(loop.keyframe).frame_index, loop.keyframe, loop.candidate,
-                      report->loop_candidate_frame, loop.inliers, loop.agreeing,
-                      loop.correction_m, loop.merged, loop.merged_from, loop.merged_into,
-                      loop.welded_keyframes, last_tracked_frame_, 0.0});
+    LoopRecord record;
+    record.frame = map.keyframe(loop.keyframe).frame_index;
+    record.keyframe = loop.keyframe;
+    record.candidate = loop.candidate;
+    record.candidate_frame = report->loop_candidate_frame;
+    record.inliers = loop.inliers;
+    record.agreeing = loop.agreeing;
+    record.correction_m = loop.correction_m;
+    record.candidate_from_keyframe = loop.candidate_from_keyframe;
+    record.merge = loop.merged;
+    record.merged_from = loop.merged_from;
+    record.merged_into = loop.merged_into;
+    record.welded_keyframes = loop.welded_keyframes;
+    record.corrected_after_frame = last_tracked_frame_;
+    loops_.push_back(record);
     ++loop_generation_;
     global_ba = options_.loop.global_ba_iterations > 0 && !interrupted_;
   };

@@ -55,6 +55,9 @@ struct LoopRecord {
   int inliers = 0;                     // verified inliers
   int agreeing = 0;                    // keyframes that agreed on it
   double correction_m = 0;             // how far the pose graph moved the keyframe
+  // The keyframe's verified pose in the candidate's camera frame, as the loop asserts it
+  // (LoopClosingResult::candidate_from_keyframe).
+  Rigid3d candidate_from_keyframe;
   bool merge = false;                  // the candidate was in another map: two maps merged
   int merged_from = -1, merged_into = -1;
   int welded_keyframes = 0;  // a merge: keyframes its seam's bundle adjustment optimised
