@@ -138,6 +138,31 @@ TEST(DataSlamFr2Desk, MappingThreadTracksEveryFrameAccurately) {
   EXPECT_GE(run.summary.keyframes, 2u);
 }
 
+// A merge in the threaded pipeline (mapping thread): a welded merge moves the map in two steps,
+// the seam's bundle adjustment solved between them while tracking goes on (frames tracked
+// meanwhile, keyframes made meanwhile taken into the pose graph). The map started after the cover
+// must still merge into the first, welded, with nearly every frame that is not black in
+// trajectory.txt and the accuracy of a covered run (atlas_test.cc runs the same sequentially).
+TEST(IntegrationAtlas, MappingThreadWeldsTheMergeWhileTrackingGoesOn) {
+  SynthOptions so;
+  so.preset = "roam";
+  so.seed = 2;
+  so.people = false;
+  so.cover_start_s = 8.0;
+  so.cover_seconds = 2.0;
+  const std::string seq = TempDir("roam_cover");
+  WriteSequence(so, seq);
+  const SlamRun run = RunAndEvaluate(seq, TempDir("roam_cover_threaded"), 42, true, "none", true);
+  EXPECT_GE(run.summary.maps_merged, 1);
+  EXPECT_EQ(run.summary.maps_left, 1);
+  int welded = 0;
+  for (const LoopRecord& loop : run.summary.loop_records) welded += loop.merge ? loop.welded_keyframes : 0;
+  EXPECT_GE(welded, 2);
+  const size_t not_black = run.summary.frames - 60;
+  EXPECT_GE(run.summary.tracked_main, static_cast<size_t>(0.95 * not_black));
+  EXPECT_LE(run.eval.ate.error_m.rmse, 0.02) << "ATE RMSE " << run.eval.ate.error_m.rmse;
+}
+
 // People walking through the view: without the dynamic filter the trajectory is far off; with
 // the ground-truth masks (oracle segmenter) it stays close to the accuracy of the static twin.
 TEST(IntegrationSlamDynamic, GroundTruthMasksRemoveThePeople) {

@@ -55,7 +55,7 @@ LoopClosingResult LoopCloser::Process(Map& map, KeyFrameId kf_id) {
 }
 
 LoopClosingResult LoopCloser::Process(const StepRunner& run_step, KeyFrameId kf_id,
-                                      const FinishFn& finish) {
+                                      const FinishFn& finish, const MovedFn& moved) {
   LoopClosingResult result;
   result.keyframe = kf_id;
   bool searched = false;       // no candidate search this time (disabled, too soon, pending)
@@ -99,6 +99,7 @@ LoopClosingResult LoopCloser::Process(const StepRunner& run_step, KeyFrameId kf_
     }
   }
   // Every change of this object's state is made inside a step (under the caller's lock).
+  std::optional<Correction> welding;  // a merge whose seam's bundle is solved between two steps
   run_step([&](Map& map) {
     // By appearance, the candidate most keyframes agree with replaces a pending loop that fewer
     // agree with.
@@ -107,15 +108,35 @@ LoopClosingResult LoopCloser::Process(const StepRunner& run_step, KeyFrameId kf_
     } else if (best && (!pending_ || best->coincidences > pending_->coincidences)) {
       pending_ = std::move(best);
     }
-    if (to_close && map.HasKeyFrame(kf_id) && map.HasKeyFrame(to_close->candidate))
-      Close(map, kf_id, *to_close, &result);
+    if (to_close && map.HasKeyFrame(kf_id) && map.HasKeyFrame(to_close->candidate)) {
+      Correction c;
+      if (Close(map, kf_id, *to_close, &result, &c)) {
+        if (moved) {
+          moved(map, c.before_merge);
+          c.tracker_moved = true;
+        }
+        welding = std::move(c);
+        return;  // `finish` once the weld is applied
+      }
+    }
+    if (finish) finish(map, result);
+  });
+  if (!welding) return result;
+  // The seam's bundle adjustment without the map (ORB-SLAM3 stops local mapping for its
+  // MergeLocal; here tracking goes on and what it adds meanwhile is taken as it is).
+  BundleOptions bo;
+  bo.max_iterations = options_.merge_weld_iterations;
+  const BundleSummary weld = SolveBundle(camera_, &welding->weld->problem, bo);
+  run_step([&](Map& map) {
+    FinishCorrection(map, kf_id, &*welding, &weld, &result);
+    FinishMerge(*welding, kf_id, &result);
     if (finish) finish(map, result);
   });
   return result;
 }
 
-void LoopCloser::Close(Map& map, KeyFrameId kf_id, const Verified& loop,
-                       LoopClosingResult* result) {
+bool LoopCloser::Close(Map& map, KeyFrameId kf_id, const Verified& loop,
+                       LoopClosingResult* result, Correction* c) {
   last_loop_kf_ = kf_id;
   pending_.reset();
   result->candidate = loop.candidate;
@@ -123,10 +144,8 @@ void LoopCloser::Close(Map& map, KeyFrameId kf_id, const Verified& loop,
   result->agreeing = std::max(1, loop.coincidences);
   result->candidate_from_keyframe =
       map.keyframe(loop.candidate).cam_from_world * loop.cam_from_world.Inverse();
-  if (map.MapOf(loop.candidate) != map.MapOf(kf_id)) {
-    Merge(map, kf_id, loop, result);
-    return;
-  }
+  if (map.MapOf(loop.candidate) != map.MapOf(kf_id)) return Merge(map, kf_id, loop, result, c);
+  c->loop = loop;
   // A revisit that the map already agrees with (the place seen again with no drift to speak of):
   // the duplicated landmarks are fused, but there is nothing to correct.
   const double moved_m = (loop.cam_from_world.Inverse().translation() -
@@ -135,7 +154,8 @@ void LoopCloser::Close(Map& map, KeyFrameId kf_id, const Verified& loop,
       Eigen::AngleAxisd(loop.correction.rotation()).angle() * 180.0 / M_PI;
   if (moved_m < options_.revisit_max_correction_m &&
       turned_deg < options_.revisit_max_correction_deg) {
-    Correct(map, kf_id, loop, /*correct_poses=*/false, /*moved=*/nullptr, result);
+    c->correct_poses = false;
+    BeginCorrection(map, kf_id, c, result);
     result->revisit = true;
     ++stats_.revisits;
     spdlog::info(
@@ -143,9 +163,10 @@ void LoopCloser::Close(Map& map, KeyFrameId kf_id, const Verified& loop,
         "landmarks fused, {:.1f} mm / {:.2f} deg off: no correction)",
         kf_id, loop.candidate, loop.inliers, loop.coincidences, result->fused, moved_m * 1000,
         turned_deg);
-    return;
+    return false;
   }
-  Correct(map, kf_id, loop, /*correct_poses=*/true, /*moved=*/nullptr, result);
+  BeginCorrection(map, kf_id, c, result);
+  FinishCorrection(map, kf_id, c, nullptr, result);
   result->closed = true;
   ++loops_closed_;
   spdlog::info(
@@ -153,70 +174,50 @@ void LoopCloser::Close(Map& map, KeyFrameId kf_id, const Verified& loop,
       "fused, correction {:.3f} m)",
       kf_id, loop.candidate, loop.inliers, loop.coincidences, result->fused,
       result->correction_m);
+  return false;
 }
 
-void LoopCloser::Merge(Map& map, KeyFrameId kf_id, Verified loop, LoopClosingResult* result) {
+bool LoopCloser::Merge(Map& map, KeyFrameId kf_id, Verified loop, LoopClosingResult* result,
+                       Correction* c) {
   const int kf_map = map.MapOf(kf_id), candidate_map = map.MapOf(loop.candidate);
   // The map whose root is older keeps its frame (so the map of the first frame never moves);
   // loop.correction is world_candidate_from_world_kf.
   const bool move_current = map.map_roots().at(kf_map) > map.map_roots().at(candidate_map);
-  const int from = move_current ? kf_map : candidate_map;
-  const int into = move_current ? candidate_map : kf_map;
-  std::map<KeyFrameId, Rigid3d> before =
-      move_current ? map.MergeMapInto(from, into, loop.correction, kf_id, loop.candidate)
-                   : map.MergeMapInto(from, into, loop.correction.Inverse(), loop.candidate,
-                                      kf_id);
+  c->merge = true;
+  c->merged_from = move_current ? kf_map : candidate_map;
+  c->merged_into = move_current ? candidate_map : kf_map;
+  c->before_merge =
+      move_current ? map.MergeMapInto(c->merged_from, c->merged_into, loop.correction, kf_id,
+                                      loop.candidate)
+                   : map.MergeMapInto(c->merged_from, c->merged_into, loop.correction.Inverse(),
+                                      loop.candidate, kf_id);
   // The verified pose of the keyframe, in the merged map's frame: now close to its own pose.
   if (!move_current) loop.cam_from_world = loop.cam_from_world * loop.correction;
   loop.correction = loop.cam_from_world.Inverse() * map.keyframe(kf_id).cam_from_world;
-  std::set<KeyFrameId> moved;
-  for (const auto& [id, pose] : before) moved.insert(id);
-  Correct(map, kf_id, loop, /*correct_poses=*/true, &moved, result);
-  // The tracker moves its last frame from the poses before the whole step.
-  for (const auto& [id, pose] : before) result->old_poses[id] = pose;
+  c->loop = std::move(loop);
+  for (const auto& [id, pose] : c->before_merge) c->moved.insert(id);
+  BeginCorrection(map, kf_id, c, result);
+  if (c->weld) return true;
+  FinishCorrection(map, kf_id, c, nullptr, result);
+  FinishMerge(*c, kf_id, result);
+  return false;
+}
+
+void LoopCloser::FinishMerge(const Correction& c, KeyFrameId kf_id, LoopClosingResult* result) {
+  // The tracker moves its last frame from the poses before the merge, unless MovedFn already did.
+  if (!c.tracker_moved) {
+    for (const auto& [id, pose] : c.before_merge) result->old_poses[id] = pose;
+  }
   result->closed = true;
   result->merged = true;
-  result->merged_from = from;
-  result->merged_into = into;
+  result->merged_from = c.merged_from;
+  result->merged_into = c.merged_into;
   ++maps_merged_;
   spdlog::info(
       "maps merged: map {} into map {} at keyframe {} with keyframe {} ({} inliers, {} keyframes "
       "agree, {} landmarks fused, {} keyframes welded, seam correction {:.3f} m)",
-      from, into, kf_id, loop.candidate, loop.inliers, loop.coincidences, result->fused,
-      result->welded_keyframes, result->correction_m);
-}
-
-std::set<KeyFrameId> LoopCloser::WeldSeam(Map& map, KeyFrameId kf_id, KeyFrameId candidate,
-                                          const std::set<KeyFrameId>& moved) {
-  const size_t side = static_cast<size_t>(options_.merge_weld_keyframes);
-  if (side == 0) return {};
-  // Each side: its seam keyframe and best covisibles of its own map (after the fusion the best
-  // covisibles may reach across the seam).
-  auto side_of = [&](KeyFrameId seam, bool in_moved) {
-    std::vector<KeyFrameId> out = {seam};
-    for (KeyFrameId c : map.BestCovisibles(seam, 1000)) {
-      if (out.size() >= side) break;
-      if ((moved.count(c) > 0) == in_moved) out.push_back(c);
-    }
-    return out;
-  };
-  const bool kf_moved = moved.count(kf_id) > 0;
-  const std::vector<KeyFrameId> adjust = side_of(kf_moved ? kf_id : candidate, true);
-  const std::vector<KeyFrameId> held = side_of(kf_moved ? candidate : kf_id, false);
-  MapBundle bundle = BuildWindowBundle(map, adjust, static_cast<int>(side), held);
-  if (bundle.problem.poses.empty() || bundle.problem.observations.empty()) return {};
-  BundleOptions bo;
-  bo.max_iterations = options_.merge_weld_iterations;
-  const BundleSummary summary = SolveBundle(camera_, &bundle.problem, bo);
-  if (!summary.usable) {
-    spdlog::warn("merge: the seam's bundle adjustment failed; the pose graph alone welds it");
-    return {};
-  }
-  ApplyMapBundle(bundle, summary, &map);
-  std::set<KeyFrameId> optimised;
-  for (const BundleProblem::Pose& p : bundle.problem.poses)
-    if (!p.fixed) optimised.insert(p.id);
-  return optimised;
+      c.merged_from, c.merged_into, kf_id, c.loop.candidate, c.loop.inliers,
+      c.loop.coincidences, result->fused, result->welded_keyframes, result->correction_m);
 }
 
 bool LoopCloser::WithinRadius(const Map& map, KeyFrameId kf_id, KeyFrameId other) const {
@@ -436,28 +437,25 @@ bool LoopCloser::ConfirmPending(const Map& map, KeyFrameId kf_id) {
   return true;
 }
 
-void LoopCloser::Correct(Map& map, KeyFrameId kf_id, const Verified& loop, bool correct_poses,
-                         const std::set<KeyFrameId>* moved, LoopClosingResult* result) {
+void LoopCloser::BeginCorrection(Map& map, KeyFrameId kf_id, Correction* c,
+                                 LoopClosingResult* result) {
+  const Verified& loop = c->loop;
   // Poses and positions before the correction.
-  std::map<KeyFrameId, Rigid3d> old_pose;
-  for (const auto& [id, k] : map.keyframes()) old_pose[id] = k.cam_from_world;
-  std::map<LandmarkId, Eigen::Vector3d> old_position;
-  for (const auto& [id, lm] : map.landmarks()) old_position[id] = lm.position;
+  for (const auto& [id, k] : map.keyframes()) c->old_pose[id] = k.cam_from_world;
+  for (const auto& [id, lm] : map.landmarks()) c->old_position[id] = lm.position;
 
   // The keyframe's neighbourhood moves rigidly with it: world_new_from_world_old.
-  const Rigid3d correction = loop.cam_from_world.Inverse() * old_pose.at(kf_id);
-  std::vector<KeyFrameId> group = map.BestCovisibles(kf_id, 1000);
-  group.push_back(kf_id);
-  const std::set<KeyFrameId> in_group(group.begin(), group.end());
-  std::map<KeyFrameId, std::set<KeyFrameId>> connected_before;
-  for (KeyFrameId g : group) {
+  const Rigid3d correction = loop.cam_from_world.Inverse() * c->old_pose.at(kf_id);
+  c->group = map.BestCovisibles(kf_id, 1000);
+  c->group.push_back(kf_id);
+  for (KeyFrameId g : c->group) {
     for (const auto& [n, w] : map.keyframe(g).covisibility) {
       (void)w;
-      connected_before[g].insert(n);
+      c->connected_before[g].insert(n);
     }
   }
-  std::map<KeyFrameId, Rigid3d> initial = old_pose;
-  for (KeyFrameId g : group) initial[g] = old_pose.at(g) * correction.Inverse();
+  c->initial = c->old_pose;
+  for (KeyFrameId g : c->group) c->initial[g] = c->old_pose.at(g) * correction.Inverse();
 
   // Fuse the keyframe's landmarks into the loop landmarks they matched.
   KeyFrame& kf = map.keyframe(kf_id);
@@ -481,28 +479,73 @@ void LoopCloser::Correct(Map& map, KeyFrameId kf_id, const Verified& loop, bool 
   fuse.window = 4.0;
   fuse.ratio = 1.0;
   fuse.max_distance = kThLow;
-  for (KeyFrameId g : group) {
-    result->fused += FuseLandmarksInto(camera_, map, g, loop.loop_landmarks, initial.at(g), fuse,
-                                       FuseWinner::kSource);
+  for (KeyFrameId g : c->group) {
+    result->fused += FuseLandmarksInto(camera_, map, g, loop.loop_landmarks, c->initial.at(g),
+                                       fuse, FuseWinner::kSource);
   }
-  for (KeyFrameId g : group) map.UpdateConnections(g);
-  if (!correct_poses) return;
+  for (KeyFrameId g : c->group) map.UpdateConnections(g);
+  if (!c->correct_poses || !c->merge || options_.merge_weld_keyframes <= 0) return;
+
+  // A merge's seam (ORB-SLAM3's MergeLocal): the moved map's side (its seam keyframe and best
+  // covisibles of its own map; after the fusion they may reach across the seam) is
+  // bundle-adjusted against the kept map's side held fixed.
+  const size_t side = static_cast<size_t>(options_.merge_weld_keyframes);
+  auto side_of = [&](KeyFrameId seam, bool in_moved) {
+    std::vector<KeyFrameId> out = {seam};
+    for (KeyFrameId k : map.BestCovisibles(seam, 1000)) {
+      if (out.size() >= side) break;
+      if ((c->moved.count(k) > 0) == in_moved) out.push_back(k);
+    }
+    return out;
+  };
+  const bool kf_moved = c->moved.count(kf_id) > 0;
+  const std::vector<KeyFrameId> adjust = side_of(kf_moved ? kf_id : loop.candidate, true);
+  const std::vector<KeyFrameId> held = side_of(kf_moved ? loop.candidate : kf_id, false);
+  MapBundle bundle = BuildWindowBundle(map, adjust, static_cast<int>(side), held);
+  if (!bundle.problem.poses.empty() && !bundle.problem.observations.empty())
+    c->weld = std::move(bundle);
+}
+
+void LoopCloser::FinishCorrection(Map& map, KeyFrameId kf_id, Correction* c,
+                                  const BundleSummary* weld, LoopClosingResult* result) {
+  if (!c->correct_poses) return;
+  const Verified& loop = c->loop;
+  // Keyframes and landmarks that tracking made since BeginCorrection (a welded merge, between
+  // its steps) are taken where they are; the pose graph moves those keyframes with the
+  // neighbours they are tied to, and their landmarks with them.
+  std::set<KeyFrameId> made_meanwhile;
+  for (const auto& [id, k] : map.keyframes()) {
+    if (c->old_pose.emplace(id, k.cam_from_world).second) {
+      c->initial[id] = k.cam_from_world;
+      made_meanwhile.insert(id);
+    }
+  }
+  for (const auto& [id, lm] : map.landmarks()) c->old_position.emplace(id, lm.position);
 
   // A merge's seam: the moved map's side is bundle-adjusted against the kept map now, and the pose
   // graph, with that window and the kept map fixed, bends the rest of the moved map to it. The
   // landmarks then move with their reference keyframes from the poses and positions after the
   // weld (`moved_from`); the edges keep the relative poses from before it.
-  std::map<KeyFrameId, Rigid3d> moved_from = old_pose;
-  const std::set<KeyFrameId> welded =
-      moved ? WeldSeam(map, kf_id, loop.candidate, *moved) : std::set<KeyFrameId>{};
-  for (KeyFrameId k : welded) initial[k] = moved_from[k] = map.keyframe(k).cam_from_world;
+  std::map<KeyFrameId, Rigid3d> moved_from = c->old_pose;
+  std::set<KeyFrameId> welded;
+  if (c->weld && weld) {
+    if (weld->usable) {
+      ApplyMapBundle(*c->weld, *weld, &map);
+      for (const BundleProblem::Pose& p : c->weld->problem.poses)
+        if (!p.fixed && map.HasKeyFrame(p.id)) welded.insert(p.id);
+    } else {
+      spdlog::warn("merge: the seam's bundle adjustment failed; the pose graph alone welds it");
+    }
+  }
+  for (KeyFrameId k : welded) c->initial[k] = moved_from[k] = map.keyframe(k).cam_from_world;
   if (!welded.empty()) {
-    for (auto& [id, pos] : old_position)
+    for (auto& [id, pos] : c->old_position)
       if (map.HasLandmark(id)) pos = map.landmark(id).position;
   }
   result->welded_keyframes = static_cast<int>(welded.size());
 
   // Essential graph: spanning tree, strong covisibility, and the new loop connections.
+  const std::set<KeyFrameId> in_group(c->group.begin(), c->group.end());
   PoseGraphProblem problem;
   std::map<KeyFrameId, size_t> node;
   const int own_map = map.MapOf(kf_id);
@@ -511,8 +554,9 @@ void LoopCloser::Correct(Map& map, KeyFrameId kf_id, const Verified& loop, bool 
     node[id] = problem.nodes.size();
     PoseGraphProblem::Node n;
     n.id = id;
-    n.cam_from_world = initial.at(id);
-    n.fixed = map.IsMapRoot(id) || welded.count(id) > 0 || (!welded.empty() && !moved->count(id));
+    n.cam_from_world = c->initial.at(id);
+    n.fixed = map.IsMapRoot(id) || welded.count(id) > 0 ||
+              (!welded.empty() && !c->moved.count(id) && !made_meanwhile.count(id));
     problem.nodes.push_back(n);
   }
   std::set<std::pair<KeyFrameId, KeyFrameId>> added;
@@ -526,19 +570,23 @@ void LoopCloser::Correct(Map& map, KeyFrameId kf_id, const Verified& loop, bool 
     problem.edges.push_back(e);
   };
   // Loop edges first (measured with the corrected group poses).
-  add_edge(kf_id, loop.candidate, initial);
-  for (KeyFrameId g : group) {
+  add_edge(kf_id, loop.candidate, c->initial);
+  for (KeyFrameId g : c->group) {
+    if (!map.HasKeyFrame(g)) continue;
     for (const auto& [n, w] : map.keyframe(g).covisibility) {
       (void)w;
-      if (!in_group.count(n) && !connected_before[g].count(n)) add_edge(g, n, initial);
+      if (!in_group.count(n) && !c->connected_before[g].count(n)) add_edge(g, n, c->initial);
     }
   }
   for (const auto& [id, k] : map.keyframes()) {
-    if (k.parent != kNoKeyFrame) add_edge(id, k.parent, old_pose);
+    if (k.parent != kNoKeyFrame) add_edge(id, k.parent, c->old_pose);
     for (const auto& [n, w] : k.covisibility) {
-      if (w >= options_.essential_min_weight) add_edge(id, n, old_pose);
+      if (w >= options_.essential_min_weight) add_edge(id, n, c->old_pose);
     }
   }
+  // The poses before this step, for the tracker.
+  std::map<KeyFrameId, Rigid3d> before_step;
+  for (const auto& [id, k] : map.keyframes()) before_step[id] = c->old_pose.at(id);
   const PoseGraphSummary s = SolvePoseGraph(&problem, PoseGraphOptions());
   if (!s.usable)
     spdlog::warn("loop closing: pose graph optimisation did not converge; using its last state");
@@ -546,7 +594,7 @@ void LoopCloser::Correct(Map& map, KeyFrameId kf_id, const Verified& loop, bool 
     map.keyframe(n.id).cam_from_world = n.cam_from_world;
 
   // Every landmark moves with its reference keyframe.
-  for (const auto& [id, pos] : old_position) {
+  for (const auto& [id, pos] : c->old_position) {
     if (!map.HasLandmark(id)) continue;
     Landmark& lm = map.landmark(id);
     KeyFrameId ref = lm.reference_keyframe;
@@ -559,8 +607,8 @@ void LoopCloser::Correct(Map& map, KeyFrameId kf_id, const Verified& loop, bool 
     map.UpdateLandmarkGeometry(id);
   }
   result->correction_m =
-      (map.keyframe(kf_id).Center() - old_pose.at(kf_id).Inverse().translation()).norm();
-  result->old_poses = std::move(old_pose);
+      (map.keyframe(kf_id).Center() - c->old_pose.at(kf_id).Inverse().translation()).norm();
+  result->old_poses = std::move(before_step);
 }
 
 }  // namespace detslam

@@ -35,6 +35,7 @@
 #include "detslam/map/map.h"
 #include "detslam/map/place_candidates.h"
 #include "detslam/map/projection_search.h"
+#include "detslam/mapping/map_bundle.h"
 
 namespace detslam {
 
@@ -119,16 +120,24 @@ class LoopCloser {
   // Called in the last step of Process, under the same access as the correction (e.g. to move the
   // tracker's state with the map), whether a loop was closed or not.
   using FinishFn = std::function<void(Map&, const LoopClosingResult&)>;
+  // A merge whose seam is welded moves the map in two steps: the first (the maps joined in one
+  // frame, the seam fused) calls this under its access with the moved keyframes' poses before it
+  // (e.g. to move the tracker's last frame, and to mark a global BA started earlier as stale);
+  // the welding bundle adjustment is then solved without the map (tracking goes on), and the
+  // second step applies it, bends the rest of the moved map (pose graph) and calls `finish`.
+  using MovedFn = std::function<void(Map&, const std::map<KeyFrameId, Rigid3d>& old_poses)>;
 
   // Looks for and closes a loop at keyframe `kf` of `map`. Deterministic.
   LoopClosingResult Process(Map& map, KeyFrameId kf);
   // The same in steps, each run by `run_step` (so a lock can be released between them and
   // tracking does not wait for the whole search): the candidate search, each candidate's
-  // verification, then the closing (fusion, pose graph) with `finish`. Between steps only
+  // verification, then the closing (fusion, pose graph) with `finish` (a welded merge: two
+  // steps, the seam's bundle adjustment solved between them, see MovedFn). Between steps only
   // tracking may change the map (new keyframes and points; the caller's thread is the one that
   // erases keyframes); results carried across steps refer to landmarks by id and are checked
   // again. With nothing else changing the map between steps, the result equals Process(map, kf).
-  LoopClosingResult Process(const StepRunner& run_step, KeyFrameId kf, const FinishFn& finish);
+  LoopClosingResult Process(const StepRunner& run_step, KeyFrameId kf, const FinishFn& finish,
+                            const MovedFn& moved = nullptr);
 
   int loops_closed() const { return loops_closed_; }  // merges not included
   int maps_merged() const { return maps_merged_; }
@@ -149,6 +158,24 @@ class LoopCloser {
     int coincidences = 0;  // keyframes that agree (appearance only)
     int misses = 0;        // next keyframes in a row that did not
   };
+  // A correction between its two parts (BeginCorrection: fusion, and for a merge the seam's
+  // bundle built; FinishCorrection: the weld applied, the pose graph, the landmarks moved), which
+  // a welded merge runs in two steps with the bundle solved between them.
+  struct Correction {
+    Verified loop;
+    bool correct_poses = true;  // false: a revisit (fusion only)
+    bool merge = false;
+    int merged_from = -1, merged_into = -1;
+    std::set<KeyFrameId> moved;                  // a merge: the moved map's keyframes
+    std::map<KeyFrameId, Rigid3d> before_merge;  // and their poses before the move
+    bool tracker_moved = false;  // MovedFn was called with before_merge
+    std::map<KeyFrameId, Rigid3d> old_pose;      // every keyframe's pose before the correction
+    std::map<LandmarkId, Eigen::Vector3d> old_position;
+    std::vector<KeyFrameId> group;  // the keyframe and its covisibles, moved rigidly with it
+    std::map<KeyFrameId, std::set<KeyFrameId>> connected_before;
+    std::map<KeyFrameId, Rigid3d> initial;  // the pose graph's starting poses
+    std::optional<MapBundle> weld;          // the seam's bundle, to solve
+  };
   bool WithinRadius(const Map& map, KeyFrameId kf, KeyFrameId other) const;
   std::vector<KeyFrameId> CandidatesByPosition(const Map& map, KeyFrameId kf) const;
   std::vector<KeyFrameId> CandidatesByAppearance(const Map& map, KeyFrameId kf) const;
@@ -168,21 +195,24 @@ class LoopCloser {
   // Appearance: a pending loop checked against the new keyframe `kf`; true if it agrees (then the
   // pending loop is re-verified at kf).
   bool ConfirmPending(const Map& map, KeyFrameId kf);
-  void Close(Map& map, KeyFrameId kf, const Verified& loop, LoopClosingResult* result);
+  // Closes the verified loop (or merges the maps). Returns true when a merge's seam bundle is left
+  // to solve (c->weld): the caller solves it, then FinishCorrection and FinishMerge.
+  bool Close(Map& map, KeyFrameId kf, const Verified& loop, LoopClosingResult* result,
+             Correction* c);
   // A verified candidate in another map: moves the map whose root is newer into the other's frame
-  // (Map::MergeMapInto), then Correct welds the seam.
-  void Merge(Map& map, KeyFrameId kf, Verified loop, LoopClosingResult* result);
-  // Fuses the loop side's landmarks into kf's neighbourhood and, with correct_poses, moves the map
-  // (pose graph, landmarks with their reference keyframes). `moved` (a merge; may be null): the
-  // keyframes of the map that was moved into the other's frame; with merge_weld_keyframes > 0 its
-  // side of the seam is welded (WeldSeam) and the pose graph moves only the rest of that map.
-  void Correct(Map& map, KeyFrameId kf, const Verified& loop, bool correct_poses,
-               const std::set<KeyFrameId>* moved, LoopClosingResult* result);
-  // The welding bundle adjustment of a merge between keyframe `kf` and `candidate`, one of them in
-  // `moved`: returns the keyframes it optimised (empty when off, without a gauge or when the
-  // solver failed).
-  std::set<KeyFrameId> WeldSeam(Map& map, KeyFrameId kf, KeyFrameId candidate,
-                                const std::set<KeyFrameId>& moved);
+  // (Map::MergeMapInto), then corrects (welds) the seam; true as for Close.
+  bool Merge(Map& map, KeyFrameId kf, Verified loop, LoopClosingResult* result, Correction* c);
+  void FinishMerge(const Correction& c, KeyFrameId kf, LoopClosingResult* result);
+  // Fuses the loop side's landmarks into kf's neighbourhood and, with c->correct_poses and a merge
+  // with merge_weld_keyframes > 0, builds the bundle of the moved map's side of the seam against
+  // the kept map's (c->weld; none when it would be empty).
+  void BeginCorrection(Map& map, KeyFrameId kf, Correction* c, LoopClosingResult* result);
+  // Applies the solved weld (`weld`: its summary, null when none was built), then the pose graph
+  // over the map (a merge's weld window and the kept map fixed), and moves every landmark with
+  // its reference keyframe. Keyframes and landmarks made since BeginCorrection are taken as they
+  // are.
+  void FinishCorrection(Map& map, KeyFrameId kf, Correction* c, const BundleSummary* weld,
+                        LoopClosingResult* result);
 
   PinholeCamera camera_;
   LoopClosingOptions options_;

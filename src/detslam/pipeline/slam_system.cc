@@ -140,7 +140,13 @@ void SlamSystem::MapKeyFrame(KeyFrameId kf, FrameReport* report) {
     ++loop_generation_;
     global_ba = options_.loop.global_ba_iterations > 0 && !interrupted_;
   };
-  loop_closer_.Process(run_step, kf, finish);
+  // A welded merge moves the map in two steps (the seam's bundle adjustment solved between them):
+  // the tracker moves with the first one, and a global BA started before it is stale.
+  const auto moved = [&](Map& map, const std::map<KeyFrameId, Rigid3d>& old_poses) {
+    tracker_.OnLoopClosed(map, old_poses);
+    ++loop_generation_;
+  };
+  loop_closer_.Process(run_step, kf, finish, moved);
   if (report->loop_closed) {
     const MapStore::WriteAccess map = store_.Write();
     loops_.back().map_locked_ms = longest_step_ms;
