@@ -183,6 +183,11 @@ class Tracker {
   // Returns the number of labelled keypoints.
   int ApplyGeometricCheck(const Map& map, Frame* frame, int* inliers);
   void UpdateLocalMap(const Map& map, const Frame& frame);
+  // TrackLocalMap's frustum check: the landmark projects into the frame at its pose (`center`:
+  // the camera centre) within the landmark's scale range and viewing angle, and, with
+  // check_withheld, not where the frame's keypoints were withheld. *uv: the projection.
+  bool InView(const Landmark& lm, const Frame& frame, const Eigen::Vector3d& center,
+              bool check_withheld, Eigen::Vector2d* uv) const;
   KeyFrameId CreateLandmarksFromDepth(Map& map, Frame* frame, KeyFrameId kf_id);
 
   PinholeCamera camera_;

@@ -84,14 +84,8 @@ bool Tracker::TrackLocalMap(Map& map, Frame* frame, int* inliers) {
     if (matched_set_.Contains(id)) continue;
     Landmark& lm = map.landmark(id);
     // Frustum check (counts as "visible" for the found ratio).
-    const Eigen::Vector3d pc = pose * lm.position;
-    if (pc.z() <= 0) continue;
-    const Eigen::Vector2d uv = camera_.Project(pc);
-    if (!camera_.InImage(uv)) continue;
-    const double dist = (lm.position - center).norm();
-    if (dist < 0.8 * lm.min_distance || dist > 1.2 * lm.max_distance) continue;
-    if ((lm.position - center).dot(lm.normal) < 0.5 * dist) continue;
-    if (check_withheld && Withheld(frame->withheld, camera_, uv)) continue;
+    Eigen::Vector2d uv;
+    if (!InView(lm, *frame, center, check_withheld, &uv)) continue;
     ++lm.visible;
     candidates.push_back(CandidateFromLandmark(lm));
   }
@@ -115,6 +109,18 @@ bool Tracker::TrackLocalMap(Map& map, Frame* frame, int* inliers) {
                          ? kRelocalizationInliers
                          : options_.min_local_map_inliers;
   return *inliers >= needed;
+}
+
+bool Tracker::InView(const Landmark& lm, const Frame& frame, const Eigen::Vector3d& center,
+                     bool check_withheld, Eigen::Vector2d* uv) const {
+  const Eigen::Vector3d pc = *frame.cam_from_world * lm.position;
+  if (pc.z() <= 0) return false;
+  *uv = camera_.Project(pc);
+  if (!camera_.InImage(*uv)) return false;
+  const double dist = (lm.position - center).norm();
+  if (dist < 0.8 * lm.min_distance || dist > 1.2 * lm.max_distance) return false;
+  if ((lm.position - center).dot(lm.normal) < 0.5 * dist) return false;
+  return !(check_withheld && Withheld(frame.withheld, camera_, *uv));
 }
 
 bool Tracker::Relocalize(const Map& map, Frame* frame) {
@@ -171,6 +177,7 @@ bool Tracker::Relocalize(const Map& map, Frame* frame) {
     int inliers = OptimizeFramePose(map, frame, false);
     spdlog::debug("  keyframe {}: PnP {} inliers, optimised {}", kf_id, pnp.num_inliers, inliers);
     if (inliers < kMinRelocalizationPnpInliers) continue;
+    const int pnp_inliers = inliers;
     if (inliers < kRelocalizationInliers) {
       // Widen with the keyframe's neighbourhood by projection.
       reference_kf_ = kf_id;
@@ -193,8 +200,21 @@ bool Tracker::Relocalize(const Map& map, Frame* frame) {
     }
     if (inliers >= kRelocalizationInliers) {
       reference_kf_ = kf_id;
-      spdlog::info("frame {}: relocalised against keyframe {} ({} inliers)", frame->index, kf_id,
-                   inliers);
+      // How much of the keyframe's neighbourhood the pose explains: the local-map points in view
+      // at it, and how many of them it matched (a diagnostic for look-alike places: a true place
+      // matches a good share of what should be seen there; ORB-SLAM3 accepts on the count alone).
+      UpdateLocalMap(map, *frame);
+      const Eigen::Vector3d center = frame->cam_from_world->Inverse().translation();
+      const bool check_withheld = options_.skip_withheld_points && !frame->withheld.empty();
+      int in_view = 0;
+      Eigen::Vector2d uv;
+      for (LandmarkId id : local_landmarks_)
+        in_view += InView(map.landmark(id), *frame, center, check_withheld, &uv) ? 1 : 0;
+      spdlog::info(
+          "frame {}: relocalised against keyframe {} ({} inliers; {} before the projection "
+          "search; {} local-map points in view)",
+          frame->index, kf_id, inliers, pnp_inliers, in_view);
+      reference_kf_ = kf_id;  // UpdateLocalMap chose one; tracking chooses again from here
       return true;
     }
   }
