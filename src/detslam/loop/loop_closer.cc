@@ -584,9 +584,6 @@ void LoopCloser::FinishCorrection(Map& map, KeyFrameId kf_id, Correction* c,
       if (w >= options_.essential_min_weight) add_edge(id, n, c->old_pose);
     }
   }
-  // The poses before this step, for the tracker.
-  std::map<KeyFrameId, Rigid3d> before_step;
-  for (const auto& [id, k] : map.keyframes()) before_step[id] = c->old_pose.at(id);
   const PoseGraphSummary s = SolvePoseGraph(&problem, PoseGraphOptions());
   if (!s.usable)
     spdlog::warn("loop closing: pose graph optimisation did not converge; using its last state");
@@ -608,7 +605,8 @@ void LoopCloser::FinishCorrection(Map& map, KeyFrameId kf_id, Correction* c,
   }
   result->correction_m =
       (map.keyframe(kf_id).Center() - c->old_pose.at(kf_id).Inverse().translation()).norm();
-  result->old_poses = std::move(before_step);
+  // The poses before this step (old_pose holds those made meanwhile too), for the tracker.
+  result->old_poses = std::move(c->old_pose);
 }
 
 }  // namespace detslam

@@ -199,7 +199,6 @@ bool Tracker::Relocalize(const Map& map, Frame* frame) {
       inliers = OptimizeFramePose(map, frame, false);
     }
     if (inliers >= kRelocalizationInliers) {
-      reference_kf_ = kf_id;
       // How much of the keyframe's neighbourhood the pose explains: the local-map points in view
       // at it, and how many of them it matched (a diagnostic for look-alike places: a true place
       // matches a good share of what should be seen there; ORB-SLAM3 accepts on the count alone).
@@ -214,7 +213,7 @@ bool Tracker::Relocalize(const Map& map, Frame* frame) {
           "frame {}: relocalised against keyframe {} ({} inliers; {} before the projection "
           "search; {} local-map points in view)",
           frame->index, kf_id, inliers, pnp_inliers, in_view);
-      reference_kf_ = kf_id;  // UpdateLocalMap chose one; tracking chooses again from here
+      reference_kf_ = kf_id;  // not UpdateLocalMap's choice: tracking chooses again from here
       return true;
     }
   }
