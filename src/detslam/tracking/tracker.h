@@ -140,6 +140,13 @@ class Tracker {
       10;                                            // PnP + pose optimisation inliers to go on
   static constexpr int kRelocalizationInliers = 50;  // inliers that accept a relocalisation; also
                                                      // TrackLocalMap's need right after one
+  // A relocalisation that reached kRelocalizationInliers only through the projection search is
+  // accepted when its PnP consensus was strong or its pose explains a fair share of what the map
+  // shows there: look-alike places (same textures, another layout) give a few consistent matches
+  // that the wide projection search then inflates, matching a small share of the points in view.
+  // Not ORB-SLAM3's rule (which accepts on the count alone); chosen on tuning seeds (docs/STATUS.md).
+  static constexpr int kRelocalizationStrongPnpInliers = 20;  // before the projection search
+  static constexpr double kRelocalizationMinViewShare = 0.10;  // inliers / local-map points in view
   static constexpr double kRelocalizationWindow =
       10;  // projection search widening a relocalisation
   static constexpr double kRelocalizationProjectionRatio = 0.9;

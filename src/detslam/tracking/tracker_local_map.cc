@@ -198,24 +198,32 @@ bool Tracker::Relocalize(const Map& map, Frame* frame) {
       }
       inliers = OptimizeFramePose(map, frame, false);
     }
-    if (inliers >= kRelocalizationInliers) {
-      // How much of the keyframe's neighbourhood the pose explains: the local-map points in view
-      // at it, and how many of them it matched (a diagnostic for look-alike places: a true place
-      // matches a good share of what should be seen there; ORB-SLAM3 accepts on the count alone).
-      UpdateLocalMap(map, *frame);
-      const Eigen::Vector3d center = frame->cam_from_world->Inverse().translation();
-      const bool check_withheld = options_.skip_withheld_points && !frame->withheld.empty();
-      int in_view = 0;
-      Eigen::Vector2d uv;
-      for (LandmarkId id : local_landmarks_)
-        in_view += InView(map.landmark(id), *frame, center, check_withheld, &uv) ? 1 : 0;
+    if (inliers < kRelocalizationInliers) continue;
+    // How much of the keyframe's neighbourhood the pose explains: the local-map points in view at
+    // it, and the share of them it matched.
+    UpdateLocalMap(map, *frame);
+    const Eigen::Vector3d center = frame->cam_from_world->Inverse().translation();
+    const bool check_withheld = options_.skip_withheld_points && !frame->withheld.empty();
+    int in_view = 0;
+    Eigen::Vector2d uv;
+    for (LandmarkId id : local_landmarks_)
+      in_view += InView(map.landmark(id), *frame, center, check_withheld, &uv) ? 1 : 0;
+    if (pnp_inliers < kRelocalizationStrongPnpInliers &&
+        inliers < kRelocalizationMinViewShare * in_view) {
       spdlog::info(
-          "frame {}: relocalised against keyframe {} ({} inliers; {} before the projection "
-          "search; {} local-map points in view)",
-          frame->index, kf_id, inliers, pnp_inliers, in_view);
-      reference_kf_ = kf_id;  // not UpdateLocalMap's choice: tracking chooses again from here
-      return true;
+          "frame {}: relocalisation against keyframe {} rejected as a look-alike place ({} "
+          "inliers, {} before the projection search: under {}; {} local-map points in view: under "
+          "{:.0f} %)",
+          frame->index, kf_id, inliers, pnp_inliers, kRelocalizationStrongPnpInliers, in_view,
+          100 * kRelocalizationMinViewShare);
+      continue;
     }
+    spdlog::info(
+        "frame {}: relocalised against keyframe {} ({} inliers; {} before the projection search; "
+        "{} local-map points in view)",
+        frame->index, kf_id, inliers, pnp_inliers, in_view);
+    reference_kf_ = kf_id;  // not UpdateLocalMap's choice: tracking chooses again from here
+    return true;
   }
   frame->landmarks.assign(frame->size(), kNoLandmark);
   return false;
