@@ -211,6 +211,24 @@ TEST(MapFile, TruncatedCorruptOtherVersionAndMismatchesAreRefused) {
   EXPECT_NO_THROW(LoadMapFile(path, fx.expected));
 }
 
+// A camera with no undistorted image area (found by fuzzing: it reached the keypoint grid's
+// check and aborted) is refused with the file's name.
+TEST(MapFile, ACameraWithNoImageAreaIsRefused) {
+  Fixture fx;
+  PinholeCamera bad = fx.camera;
+  bad.height = 0;
+  const std::string path = TempPath("bad_camera.dslmap");
+  WriteAll(path, EncodeMapFile(MakeMap(fx.camera), bad, 0x1234));
+  try {
+    ReadMapFileInfo(path);
+    ADD_FAILURE() << "accepted";
+  } catch (const InputError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("no undistorted image area"), std::string::npos) << what;
+    EXPECT_NE(what.find(path), std::string::npos) << what;
+  }
+}
+
 // Every prefix and many single-byte changes with a recomputed checksum (so that the parser itself
 // meets the damage): an InputError or a valid map, never a crash.
 TEST(MapFile, DamageBehindAValidChecksumNeverCrashes) {

@@ -144,7 +144,8 @@ class Tracker {
   // accepted when its PnP consensus was strong or its pose explains a fair share of what the map
   // shows there: look-alike places (same textures, another layout) give a few consistent matches
   // that the wide projection search then inflates, matching a small share of the points in view.
-  // Not ORB-SLAM3's rule (which accepts on the count alone); chosen on tuning seeds (docs/STATUS.md).
+  // Not ORB-SLAM3's rule (which accepts on the count alone); chosen on tuning seeds
+  // (docs/STATUS.md).
   static constexpr int kRelocalizationStrongPnpInliers = 20;  // before the projection search
   static constexpr double kRelocalizationMinViewShare = 0.10;  // inliers / local-map points in view
   static constexpr double kRelocalizationWindow =
