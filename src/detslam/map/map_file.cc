@@ -56,11 +56,11 @@ PinholeCamera GetCamera(ByteReader* r) {
   for (double* v : {&c.fx, &c.fy, &c.cx, &c.cy, &c.k1, &c.k2, &c.p1, &c.p2, &c.k3, &c.bf})
     *v = r->F64("camera parameters");
   // The keyframes' keypoint grids span the undistorted image: a camera whose size, focal lengths
-  // or distortion leave no such area (or are not finite) cannot have made this map.
+  // or distortion leave no finite, non-empty such area cannot have made this map (a size <= 0, a
+  // zero or non-finite focal length all show up here).
   const ImageBounds b = UndistortedBounds(c);
-  if (c.width <= 0 || c.height <= 0 || !std::isfinite(c.fx) || !std::isfinite(c.fy) ||
-      c.fx == 0 || c.fy == 0 || !(b.max_x > b.min_x) || !(b.max_y > b.min_y) ||
-      !std::isfinite(b.max_x - b.min_x) || !std::isfinite(b.max_y - b.min_y))
+  const double w = b.max_x - b.min_x, h = b.max_y - b.min_y;
+  if (!(w > 0 && h > 0 && std::isfinite(w) && std::isfinite(h)))
     r->Fail("camera: invalid size, focal length or distortion (no undistorted image area)");
   return c;
 }
