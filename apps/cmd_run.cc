@@ -41,6 +41,7 @@ struct RunArgs {
   bool sync_segmentation = false;  // --sync-segmentation: with --realtime, segment every frame taken
   int camera_preload_mb = -1;      // --camera-preload-mb (-1: RunOptions' default)
   bool inline_mapping = false;
+  bool inline_loop_closing = false;
   std::string segmenter;  // empty: dnn if the models are found, else none
   std::string models;
   double alpha = -1;
@@ -141,6 +142,7 @@ void Run(RunArgs a) {
   if (a.camera_preload_mb >= 0) options.camera_preload_mb = static_cast<size_t>(a.camera_preload_mb);
   options.slam = SlamOptionsFromSettings(settings, a.seed);
   options.mapping_thread = a.threaded && !a.inline_mapping;
+  options.loop_thread = !a.inline_loop_closing;
   if (a.alpha >= 0) options.slam.dynamic.filter.alpha = a.alpha;
   if (a.no_depth_step) options.slam.dynamic.filter.depth_step = false;
   if (a.geometric_check) options.slam.dynamic.geometric.enabled = true;
@@ -276,6 +278,8 @@ void AddRunCommand(CLI::App& app) {
       ->check(CLI::NonNegativeNumber);
   cmd->add_flag("--inline-mapping", args->inline_mapping,
                 "With --threaded: local mapping in the tracking thread (then the trajectory equals the sequential one)");
+  cmd->add_flag("--inline-loop-closing", args->inline_loop_closing,
+                "With --threaded: loop closing in the local-mapping thread, after each keyframe's local mapping (default: a thread of its own)");
   cmd->add_flag("--no-progress", args->no_progress, "No progress bar");
   cmd->add_option("--save-map", args->save_map,
                   "Write the final map to this map file (keyframes, map points, covisibility; `detslam map info FILE`)");

@@ -112,21 +112,30 @@ print(f"Memory (resident, sampled twice a second): {start[4]:.0f} MiB at the fir
 
 # Stalls around loop corrections and global BA solutions applied.
 events = [(f"loop {'merge' if l['merge'] else 'closed'} at keyframe {l['keyframe']} (frame {l['frame']})",
-           l["corrected_after_frame"], l.get("map_locked_ms")) for l in run["loops"]]
-events += [(f"global BA applied", f, None) for f in run["global_ba"].get("applied_after_frames", [])]
+           l["corrected_after_frame"], l.get("map_locked_ms"), l.get("mapping_held_ms")) for l in run["loops"]]
+events += [(f"global BA applied", f, None, None) for f in run["global_ba"].get("applied_after_frames", [])]
+loop_thread = bool(run.get("loop_closing_thread"))
+lc = run["timings"].get("loop_closing_per_keyframe", {})
+lm = run["timings"].get("local_mapping_per_keyframe", {})
+print(f"Loop closing ran {'in a thread of its own' if loop_thread else 'in the local-mapping thread'}: "
+      f"{lc.get('mean_ms', float('nan')):.1f} ms per keyframe on average (max {lc.get('max_ms', float('nan')):.1f}) "
+      f"for the search and verification, local mapping {lm.get('mean_ms', float('nan')):.1f} ms per keyframe "
+      f"(max {lm.get('max_ms', float('nan')):.1f})"
+      + (" without it" if loop_thread else " with it") + ".\n")
 worst_stall = 0.0
 print("Tracking around each loop correction and global bundle adjustment (frames tracked from 2 before "
       "to 30 after it was applied):\n")
-print("| event | applied after frame | map locked by loop closing ms | longest tracking ms | longest latency ms |")
-print("|---|---:|---:|---:|---:|")
-for name, f, locked in events:
+print("| event | applied after frame | map locked by loop closing ms | local mapping held ms | longest tracking ms | longest latency ms |")
+print("|---|---:|---:|---:|---:|---:|")
+for name, f, locked, held in events:
     w = window(f - 2, f + 31)
     longest = max((x["tracking_ms"] for x in w), default=float("nan"))
     lat = max((x["latency_ms"] for x in w), default=float("nan"))
     worst_stall = max(worst_stall, longest)
-    print(f"| {name} | {f} | {'-' if locked is None else f'{locked:.1f}'} | {longest:.1f} | {lat:.1f} |")
+    held_text = "-" if held is None or not loop_thread else f"{held:.1f}"
+    print(f"| {name} | {f} | {'-' if locked is None else f'{locked:.1f}'} | {held_text} | {longest:.1f} | {lat:.1f} |")
 if not events:
-    print("| (no loop closed, no global BA) | - | - | - | - |")
+    print("| (no loop closed, no global BA) | - | - | - | - | - |")
 whole = max(per_frame, key=lambda x: x["tracking_ms"])
 over = sum(1 for x in per_frame if x["tracking_ms"] > STALL_MS)
 print(f"\nOver the whole run: longest tracking time {whole['tracking_ms']:.1f} ms (frame {whole['index']}); "

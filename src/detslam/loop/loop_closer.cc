@@ -55,7 +55,8 @@ LoopClosingResult LoopCloser::Process(Map& map, KeyFrameId kf_id) {
 }
 
 LoopClosingResult LoopCloser::Process(const StepRunner& run_step, KeyFrameId kf_id,
-                                      const FinishFn& finish, const MovedFn& moved) {
+                                      const FinishFn& finish, const MovedFn& moved,
+                                      const std::function<void()>& before_closing) {
   LoopClosingResult result;
   result.keyframe = kf_id;
   bool searched = false;       // no candidate search this time (disabled, too soon, pending)
@@ -99,6 +100,10 @@ LoopClosingResult LoopCloser::Process(const StepRunner& run_step, KeyFrameId kf_
     }
   }
   // Every change of this object's state is made inside a step (under the caller's lock).
+  const bool closing = to_close.has_value() ||
+                       (best && (!by_appearance ||
+                                 best->coincidences >= options_.consistent_detections));
+  if (closing && before_closing) before_closing();
   std::optional<Correction> welding;  // a merge whose seam's bundle is solved between two steps
   run_step([&](Map& map) {
     // By appearance, the candidate most keyframes agree with replaces a pending loop that fewer

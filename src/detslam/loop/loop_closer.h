@@ -136,8 +136,12 @@ class LoopCloser {
   // tracking may change the map (new keyframes and points; the caller's thread is the one that
   // erases keyframes); results carried across steps refer to landmarks by id and are checked
   // again. With nothing else changing the map between steps, the result equals Process(map, kf).
+  // `before_closing` (may be null) is called, outside any step, just before the step that closes
+  // a loop or merges maps, i.e. only when one will be: e.g. to hold a local-mapping thread that
+  // erases keyframes and runs bundle adjustments, until Process returns.
   LoopClosingResult Process(const StepRunner& run_step, KeyFrameId kf, const FinishFn& finish,
-                            const MovedFn& moved = nullptr);
+                            const MovedFn& moved = nullptr,
+                            const std::function<void()>& before_closing = nullptr);
 
   int loops_closed() const { return loops_closed_; }  // merges not included
   int maps_merged() const { return maps_merged_; }

@@ -180,7 +180,9 @@ void WriteRunOutputs(const RgbdSource& dataset, const Settings& settings, const 
                      {"merge", r.merge},
                      {"welded_keyframes", r.welded_keyframes},
                      {"corrected_after_frame", r.corrected_after_frame},
-                     {"map_locked_ms", r.map_locked_ms}});
+                     {"map_locked_ms", r.map_locked_ms},
+                     {"mapping_wait_ms", r.mapping_wait_ms},
+                     {"mapping_held_ms", r.mapping_held_ms}});
   }
   j["loops"] = loops;
   const LoopDetectionStats& ld = summary.loop_detection;
@@ -267,7 +269,9 @@ void WriteRunOutputs(const RgbdSource& dataset, const Settings& settings, const 
                   {"extraction", StatsJson(summary.extraction)},
                   {"tracking", StatsJson(summary.tracking)},
                   {"local_mapping_per_keyframe", StatsJson(summary.mapping)},
+                  {"loop_closing_per_keyframe", StatsJson(summary.loop_closing)},
                   {"total_per_frame", StatsJson(summary.total)}};
+  j["loop_closing_thread"] = summary.loop_thread;
   nlohmann::json per_frame = nlohmann::json::array();
   for (const FrameReport& r : summary.reports) {
     auto fm = final_map.find(r.stamp.Seconds());

@@ -220,6 +220,8 @@ class RunRecorder {
     summary_.extraction = ComputeErrorStats(ext_);
     summary_.tracking = ComputeErrorStats(trk_);
     summary_.mapping = ComputeErrorStats(slam.mapping_times_ms());
+    summary_.loop_closing = ComputeErrorStats(slam.loop_closing_times_ms());
+    summary_.loop_thread = options.threaded && options.mapping_thread && options.loop_thread;
     summary_.total = ComputeErrorStats(total_ms_);
     summary_.latency = ComputeErrorStats(latency_);
     summary_.latency_p99_ms = Percentile(latency_, 99);
@@ -453,6 +455,7 @@ RunSummary RunThreaded(const RgbdSource& dataset, const Settings& settings,
   const OpenCvThreads cv_threads(options.realtime ? options.camera_rate_opencv_threads : 0);
   SlamOptions slam_options = options.slam;
   slam_options.global_ba_thread = options.mapping_thread;  // nothing waits for it then
+  slam_options.loop_thread = options.mapping_thread && options.loop_thread;
   SlamSystem slam(settings.camera, slam_options, segmenter);
   const size_t n = FrameCount(dataset, options);
   RunRecorder recorder(n, progress, options);
@@ -474,6 +477,10 @@ RunSummary RunThreaded(const RgbdSource& dataset, const Settings& settings,
   BoundedQueue<LoadedFrame> loaded(capacity);
   BoundedQueue<Extracted> extracted(capacity);
   BoundedQueue<KeyFrameId> keyframes(8);
+  // Keyframes local mapping finished, for the loop-closing thread (ids only; the bound is never
+  // reached in practice, and a full queue only makes local mapping wait, never a deadlock: local
+  // mapping pushes outside its turn, see SlamSystem::loop_thread).
+  BoundedQueue<KeyFrameId> to_close(1024);
   // Asynchronous segmentation: the newest frame for the segmentation thread, and its results.
   const bool async = options.realtime && options.async_segmentation && segmenter != nullptr;
   BoundedQueue<LoadedFrame> to_segment(1);
@@ -484,6 +491,7 @@ RunSummary RunThreaded(const RgbdSource& dataset, const Settings& settings,
     loaded.Close();
     extracted.Close();
     keyframes.Close();
+    to_close.Close();
     to_segment.Close();
     carrier.Close();
   };
@@ -604,14 +612,31 @@ RunSummary RunThreaded(const RgbdSource& dataset, const Settings& settings,
         to_segment.Close();
       });
   if (options.mapping_thread) {
-    stages.Start("local mapping", [&] {
-      if (options.realtime) LowerThisThreadPriority(options.background_nice);
-      while (std::optional<KeyFrameId> kf = keyframes.Pop()) {
-        if (StopRequested(options)) break;  // the keyframe stays in the map, not locally mapped
-        FrameReport unused;
-        slam.MapKeyFrame(*kf, &unused);
-      }
-    });
+    stages.Start(
+        "local mapping",
+        [&] {
+          if (options.realtime) LowerThisThreadPriority(options.background_nice);
+          while (std::optional<KeyFrameId> kf = keyframes.Pop()) {
+            if (StopRequested(options)) break;  // the keyframe stays in the map, not locally mapped
+            FrameReport unused;
+            slam.MapKeyFrame(*kf, &unused);
+            if (slam_options.loop_thread && !to_close.Push(*kf)) break;  // loop closing failed
+          }
+        },
+        [&] { to_close.Close(); });
+  }
+  if (slam_options.loop_thread) {
+    stages.Start(
+        "loop closing",
+        [&] {
+          if (options.realtime) LowerThisThreadPriority(options.background_nice);
+          while (std::optional<KeyFrameId> kf = to_close.Pop()) {
+            if (StopRequested(options)) break;
+            FrameReport unused;
+            slam.CloseLoops(*kf, &unused);
+          }
+        },
+        [&] { to_close.Close(); });
   }
   // When the last processed frame got its pose (the processed frame rate's end, not the threads'
   // ends: the mapping and segmentation threads finish their current work after it).

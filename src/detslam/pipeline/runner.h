@@ -24,6 +24,9 @@ struct RunOptions {
   int64_t max_frames = -1;      // stop after this many frames (< 0: all)
   bool threaded = false;        // one thread per stage (see RunThreaded)
   bool mapping_thread = false;  // threaded: local mapping in its own thread (not deterministic)
+  // With mapping_thread: loop closing in a thread of its own too (SlamOptions::loop_thread);
+  // false: the local-mapping thread closes loops after each keyframe.
+  bool loop_thread = true;
   size_t queue_capacity = 4;    // frames buffered between the threaded stages
   // Camera-rate mode (threaded only; RunThreaded): a camera thread offers frame i when its
   // timestamp comes (relative to the first frame's), as a live camera delivers them, and holds one
@@ -128,6 +131,8 @@ struct RunSummary {
   DenseMapStats dense;        // of the dense map (dense_map)
   double wall_s = 0;
   ErrorStats segmentation, extraction, tracking, mapping, total;  // per-stage times, ms
+  ErrorStats loop_closing;  // per keyframe, ms (SlamSystem::loop_closing_times_ms)
+  bool loop_thread = false;  // loop closing ran in a thread of its own
   std::string segmenter;  // backend name, empty without segmentation
   std::vector<FrameReport> reports;
   double TrackedFraction() const { return frames ? static_cast<double>(tracked) / frames : 0.0; }
@@ -152,8 +157,9 @@ RunSummary RunSequential(const RgbdSource& dataset, const Settings& settings,
 // camera feeds the extraction thread, which hands the newest frame to a segmentation thread that
 // nothing waits for (see RunOptions::async_segmentation).
 // With options.mapping_thread, local mapping runs in a fourth thread fed by a keyframe queue
-// (results then depend on timing); without it, mapping runs in the tracking thread and the
-// trajectory equals the sequential one. An exception in any stage stops the others and is
+// (results then depend on timing), and with options.loop_thread loop closing in a fifth, fed by
+// the keyframes local mapping finished; without mapping_thread, mapping and loop closing run in
+// the tracking thread and the trajectory equals the sequential one. An exception in any stage stops the others and is
 // rethrown here.
 RunSummary RunThreaded(const RgbdSource& dataset, const Settings& settings,
                        const RunOptions& options, const ProgressFn& progress = nullptr,

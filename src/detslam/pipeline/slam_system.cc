@@ -86,20 +86,34 @@ std::vector<LoopRecord> SlamSystem::loops() const {
 
 void SlamSystem::MapKeyFrame(KeyFrameId kf, FrameReport* report) {
   const auto t0 = std::chrono::steady_clock::now();
-  abort_local_ba_ = false;  // a request from before this keyframe was for the previous one
-  LocalMappingControl control;
-  control.keyframes_waiting = [this] { return keyframes_to_map_ > 1; };
-  control.abort_ba = &abort_local_ba_;
-  const LocalMappingSummary s = mapper_.ProcessKeyFrame(kf, &store_, control);
-  if (s.skipped_for_waiting) ++keyframes_mapped_in_burst_;
-  bool global_ba = false;
   {
+    // With loop closing in its own thread, a correction waits for this keyframe's local mapping.
+    std::unique_lock<std::mutex> turn(mapping_turn_, std::defer_lock);
+    if (options_.loop_thread) turn.lock();
+    abort_local_ba_ = false;  // a request from before this keyframe was for the previous one
+    LocalMappingControl control;
+    control.keyframes_waiting = [this] { return keyframes_to_map_ > 1; };
+    control.abort_ba = &abort_local_ba_;
+    const LocalMappingSummary s = mapper_.ProcessKeyFrame(kf, &store_, control);
+    if (s.skipped_for_waiting) ++keyframes_mapped_in_burst_;
     const MapStore::WriteAccess map = store_.Write();
     for (const ErasedKeyFrame& e : s.erased_keyframes) {
       erased_[e.id] = e;
       tracker_.OnKeyFrameErased(*map, e.id);
     }
   }
+  if (!options_.loop_thread) CloseLoops(kf, report);
+  report->timings.mapping_ms = MsSince(t0);
+  {
+    const MapStore::WriteAccess map = store_.Write();
+    mapping_times_ms_.push_back(report->timings.mapping_ms);
+  }
+  --keyframes_to_map_;
+}
+
+void SlamSystem::CloseLoops(KeyFrameId kf, FrameReport* report) {
+  const auto t0 = std::chrono::steady_clock::now();
+  bool global_ba = false;
   // Loop closing in steps, each under its own write access, so that tracking goes on between
   // the candidate search and each candidate's verification; the correction and everything that
   // must move with it (the tracker, the bookkeeping) share the last step.
@@ -146,10 +160,29 @@ void SlamSystem::MapKeyFrame(KeyFrameId kf, FrameReport* report) {
     tracker_.OnLoopClosed(map, old_poses);
     ++loop_generation_;
   };
-  loop_closer_.Process(run_step, kf, finish, moved);
-  if (report->loop_closed) {
+  // With its own thread, a correction holds local mapping (mapping_turn_) from just before the
+  // closing step until its last step is done.
+  std::unique_lock<std::mutex> turn(mapping_turn_, std::defer_lock);
+  std::chrono::steady_clock::time_point held_since;
+  double wait_ms = 0;
+  const auto hold_mapping = [&] {
+    if (!options_.loop_thread) return;
+    const auto w0 = std::chrono::steady_clock::now();
+    turn.lock();
+    held_since = std::chrono::steady_clock::now();
+    wait_ms = std::chrono::duration<double, std::milli>(held_since - w0).count();
+  };
+  loop_closer_.Process(run_step, kf, finish, moved, hold_mapping);
+  const double held_ms = turn.owns_lock() ? MsSince(held_since) : 0.0;
+  if (turn.owns_lock()) turn.unlock();
+  {
     const MapStore::WriteAccess map = store_.Write();
-    loops_.back().map_locked_ms = longest_step_ms;
+    if (report->loop_closed) {
+      loops_.back().map_locked_ms = longest_step_ms;
+      loops_.back().mapping_wait_ms = wait_ms;
+      loops_.back().mapping_held_ms = held_ms;
+    }
+    loop_closing_times_ms_.push_back(MsSince(t0));
   }
   if (global_ba) {
     // Without the lock: tracking (and, in its own thread, local mapping) goes on while the whole
@@ -184,14 +217,16 @@ void SlamSystem::MapKeyFrame(KeyFrameId kf, FrameReport* report) {
       run();
     }
   }
-  report->timings.mapping_ms = MsSince(t0);
-  mapping_times_ms_.push_back(report->timings.mapping_ms);
-  --keyframes_to_map_;
 }
 
 std::vector<double> SlamSystem::mapping_times_ms() const {
   const MapStore::ReadAccess map = store_.Read();
   return mapping_times_ms_;
+}
+
+std::vector<double> SlamSystem::loop_closing_times_ms() const {
+  const MapStore::ReadAccess map = store_.Read();
+  return loop_closing_times_ms_;
 }
 
 MapFileInfo SlamSystem::LoadMap(const std::string& path) {

@@ -6,6 +6,7 @@
 #include <atomic>
 #include <map>
 #include <memory>
+#include <mutex>
 #include <opencv2/core.hpp>
 #include <string>
 #include <thread>
@@ -39,6 +40,13 @@ struct SlamOptions {
   // nor local mapping waits for it (the threaded runner with a mapping thread sets this). A new
   // loop waits for the previous one's to finish.
   bool global_ba_thread = false;
+  // Loop closing in a thread of its own (ORB-SLAM3's LoopClosing thread): the caller runs
+  // MapKeyFrame in the local-mapping thread and CloseLoops, for each keyframe it finished, in
+  // a loop-closing thread, so local mapping never waits for the loop search and verification. A
+  // correction (fusion, pose graph, a merge's weld) waits for local mapping to finish the keyframe
+  // it is mapping and holds local mapping while it runs (ORB-SLAM3 stops local mapping for it);
+  // tracking goes on between its steps. false: MapKeyFrame closes loops right after local mapping.
+  bool loop_thread = false;
   // Localisation mode (with a loaded map, LoadMap): track against the map only; no keyframes, no
   // map points, no local mapping or loop closing. Between relocalisations the tracker follows the
   // camera on frame-to-frame points from depth (visual odometry).
@@ -61,6 +69,9 @@ struct LoopRecord {
   bool merge = false;                  // the candidate was in another map: two maps merged
   int merged_from = -1, merged_into = -1;
   int welded_keyframes = 0;  // a merge: keyframes its seam's bundle adjustment optimised
+  // Loop closing in its own thread (SlamOptions::loop_thread): how long the correction waited for
+  // local mapping to finish its keyframe, and how long it then held local mapping; 0 otherwise.
+  double mapping_wait_ms = 0, mapping_held_ms = 0;
   // When the correction was applied: the newest input frame tracked by then (a mapping thread
   // corrects some frames after the keyframe's), and the longest time loop closing held the map's
   // lock in one step for this keyframe (candidate search, one candidate's verification, or the
@@ -170,9 +181,13 @@ class SlamSystem {
   // `tracked`, the frame as tracked (its keypoints' landmarks, outliers and labels) is moved there
   // (for a viewer).
   KeyFrameId TrackFrame(Frame frame, FrameReport* report, Frame* tracked = nullptr);
-  // Local mapping stage: local mapping and loop closing of a keyframe from TrackFrame. Fills
-  // report->timings.mapping_ms and loop_closed.
+  // Local mapping stage: local mapping of a keyframe from TrackFrame and, unless loop closing has
+  // a thread of its own (SlamOptions::loop_thread), its loop closing. Fills
+  // report->timings.mapping_ms and the loop fields.
   void MapKeyFrame(KeyFrameId kf, FrameReport* report);
+  // Loop-closing stage (SlamOptions::loop_thread): loop detection and closing of a keyframe that
+  // MapKeyFrame finished, in the order MapKeyFrame finished them. Fills the report's loop fields.
+  void CloseLoops(KeyFrameId kf, FrameReport* report);
 
   // Every tracked frame's pose, recomputed from its reference keyframe's current pose, by map.
   MapTrajectories FrameTrajectories() const;
@@ -182,8 +197,12 @@ class SlamSystem {
   Trajectory KeyFrameTrajectory() const;
   // Read access to the map (holds the lock while it lives).
   MapStore::ReadAccess ReadMap() const { return store_.Read(); }
-  // Local-mapping time of every processed keyframe (ms), in processing order.
+  // Local-mapping time of every processed keyframe (ms), in processing order (with the loop
+  // closing of the keyframe unless it has a thread of its own).
   std::vector<double> mapping_times_ms() const;
+  // Loop-closing time of every keyframe it processed (ms): the search, verification and any
+  // correction, not the global BA that follows.
+  std::vector<double> loop_closing_times_ms() const;
   // Loops closed so far (merges not included), maps merged so far.
   int loops_closed() const;
   int maps_merged() const;
@@ -241,6 +260,11 @@ class SlamSystem {
   std::vector<TrackedFrame> tracked_;
   std::map<KeyFrameId, ErasedKeyFrame> erased_;
   std::vector<double> mapping_times_ms_;
+  std::vector<double> loop_closing_times_ms_;
+  // With loop_thread: held by local mapping while it maps a keyframe and by loop closing while it
+  // corrects the map, so the two never interleave their steps (the correction needs the map as
+  // local mapping left it, and a local BA solved meanwhile would undo the correction).
+  std::mutex mapping_turn_;
   std::vector<LoopRecord> loops_;
   int64_t last_tracked_frame_ = -1;  // the newest frame TrackFrame has seen
   int64_t keyframe_wait_since_ = -1;  // the first frame whose keyframe was deferred (-1: none)
