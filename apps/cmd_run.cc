@@ -268,7 +268,7 @@ void AddRunCommand(CLI::App& app) {
                   "Override a settings key, KEY=VALUE (repeatable), e.g. --set Dynamic.MaskDilation=10; "
                   "the keys: detslam settings --list");
   cmd->add_flag("--threaded", args->threaded,
-                "One thread per stage: loading+segmentation, extraction, tracking, local mapping (real-time use; not bit-reproducible)");
+                "One thread per stage: loading+segmentation, extraction, tracking, local mapping, loop closing (real-time use; not bit-reproducible)");
   cmd->add_flag("--realtime", args->realtime,
                 "Camera rate: offer the frames at their timestamps as a live camera would (implies --threaded); a frame the pipeline has not taken when the next arrives is dropped, never queued; run.json reports the frames dropped and each frame's latency from arrival to pose");
   cmd->add_flag("--sync-segmentation", args->sync_segmentation,

@@ -8,9 +8,11 @@ Usage: long_run_report.py PREFIX RUN_DIR ATE_M MONITOR_EXIT FRAMES
   RUN_DIR: the run's output folder (run.json with its per-frame log)
 
 The issue's targets for a long run, each computed from the run's own run.json:
-- per-frame cost that does not grow: median tracking time (tracking_ms: from taking the map's lock
-  to the pose, so waiting for the mapping thread is included) over the processed frames of the
-  last 10 % of the input at most 1.2x that over the first 10 %;
+- per-frame cost that does not grow: median tracking time (tracking_ms: wall clock from taking the
+  map's lock to the pose, so waiting for the mapping thread and time the other threads took the
+  core are included) over the processed frames of the last 10 % of the input at most 1.2x that
+  over the first 10 %; checked on the wall clock, and shown beside it on the tracking thread's own
+  CPU time for the same span (tracking_cpu_ms: the cost itself, without waits and preemption);
 - memory reported per 1000 keyframes: (RSS at the last frame - RSS at the first sample) over the
   keyframes added in between, x 1000 (an upper bound for the map's share: it also holds every
   frame's log and trajectory entry, which grow with the frames);
@@ -89,7 +91,12 @@ print()
 print("Per-frame cost, first against last 10 % of the input frames (processed frames only):\n")
 print("| per frame | first 10 % | last 10 % | last / first |")
 print("|---|---:|---:|---:|")
-rows = [("tracking ms, median", med(first, "tracking_ms"), med(last, "tracking_ms")),
+has_cpu = all(x.get("tracking_cpu_ms", -1) >= 0 for x in first + last)
+rows = [("tracking ms, median", med(first, "tracking_ms"), med(last, "tracking_ms"))]
+if has_cpu:
+    rows += [("tracking CPU ms (the tracking thread's own time), median", med(first, "tracking_cpu_ms"),
+              med(last, "tracking_cpu_ms"))]
+rows += [
         ("extraction ms, median", med(first, "extraction_ms"), med(last, "extraction_ms")),
         ("latency arrival to pose ms, median", med(first, "latency_ms"), med(last, "latency_ms")),
         ("latency ms, 99th percentile", p99(first, "latency_ms"), p99(last, "latency_ms")),
@@ -98,11 +105,15 @@ for name, a, b in rows:
     fmt = (lambda v: f"{v:.0f}") if name.startswith("frames") else (lambda v: f"{v:.1f}")
     print(f"| {name} | {fmt(a)} | {fmt(b)} | {b / a if a else float('nan'):.2f} |")
 ratio = med(last, "tracking_ms") / med(first, "tracking_ms")
+cpu_ratio = med(last, "tracking_cpu_ms") / med(first, "tracking_cpu_ms") if has_cpu else float("nan")
 tenths = [med(window(k * offered // 10, (k + 1) * offered // 10), "tracking_ms") for k in range(10)]
-print(f"\nMedian tracking ms per tenth of the input frames: {' / '.join(f'{v:.1f}' for v in tenths)} "
-      f"(the tracker's local map, the keyframes that see the frame's points and their best covisibles, "
+print(f"\nMedian tracking ms per tenth of the input frames: {' / '.join(f'{v:.1f}' for v in tenths)}"
+      + (f"; CPU ms: {' / '.join(f'{v:.1f}' for v in (med(window(k * offered // 10, (k + 1) * offered // 10), 'tracking_cpu_ms') for k in range(10)))}"
+         if has_cpu else "")
+      + " (the tracker's local map, the keyframes that see the frame's points and their best covisibles, "
       f"is capped at 80 keyframes (TrackerOptions::max_local_keyframes) as in ORB-SLAM3: the cost grows while the map "
-      f"fills up to it, then stays).")
+      f"fills up to it, then stays; the wall clock also grows with the work of the mapping threads that share the "
+      f"two cores).")
 print()
 print(f"Memory (resident, sampled twice a second): {start[4]:.0f} MiB at the first sample (frame "
       f"{start[1]}, {start[2]} keyframes), {s10[4]:.0f} at 10 %, {s50[4]:.0f} at 50 %, {end[4]:.0f} at "
@@ -147,8 +158,8 @@ def target(name, ok, detail):
 
 
 print("Targets of the issue:")
-target("median tracking time of the last 10 % at most 1.2x the first 10 %'s", ratio <= 1.2,
-       f"{ratio:.2f}")
+target("median tracking time of the last 10 % at most 1.2x the first 10 %'s (wall clock)", ratio <= 1.2,
+       f"{ratio:.2f}" + (f"; on the tracking thread's CPU time {cpu_ratio:.2f}" if has_cpu else ""))
 target("peak memory reported per 1000 keyframes", mib_per_1000 == mib_per_1000,
        f"{mib_per_1000:.0f} MiB per 1000 keyframes; peak {peak:.0f} MiB")
 target("no tracking stall longer than 2 frame periods while a loop is corrected",

@@ -296,6 +296,7 @@ void WriteRunOutputs(const RgbdSource& dataset, const Settings& settings, const 
                          {"extraction_ms", r.timings.extraction_ms},
                          {"tracking_ms", r.timings.tracking_ms},
                          {"map_wait_ms", r.timings.map_wait_ms},
+                         {"tracking_cpu_ms", r.timings.tracking_cpu_ms},
                          {"mapping_ms", r.timings.mapping_ms}});
     if (r.latency_ms >= 0) per_frame.back()["latency_ms"] = r.latency_ms;
     if (r.mask_age >= 0) {

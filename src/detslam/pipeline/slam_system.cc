@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <ctime>
 #include <sstream>
 
 #include <spdlog/spdlog.h>
@@ -18,6 +19,16 @@ namespace {
 
 double MsSince(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+// CPU time the calling thread has used, ms (-1 where the platform cannot tell).
+double ThreadCpuMs() {
+#if defined(CLOCK_THREAD_CPUTIME_ID)
+  timespec ts{};
+  if (clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts) == 0)
+    return static_cast<double>(ts.tv_sec) * 1e3 + static_cast<double>(ts.tv_nsec) * 1e-6;
+#endif
+  return -1;
 }
 
 // Localisation mode tracks against the loaded map only: no new maps either.
@@ -345,6 +356,7 @@ Frame SlamSystem::ExtractFrame(int64_t index, Timestamp stamp, const cv::Mat& gr
 
 KeyFrameId SlamSystem::TrackFrame(Frame frame, FrameReport* report, Frame* tracked) {
   auto t0 = std::chrono::steady_clock::now();
+  const double cpu0 = ThreadCpuMs();
   const MapStore::WriteAccess access = store_.Write();
   report->timings.map_wait_ms = MsSince(t0);
   Map& map = *access;
@@ -381,6 +393,8 @@ KeyFrameId SlamSystem::TrackFrame(Frame frame, FrameReport* report, Frame* track
     report->keyframe_stale_masks = stale;
   }
   report->timings.tracking_ms = MsSince(t0);
+  const double cpu1 = ThreadCpuMs();
+  report->timings.tracking_cpu_ms = cpu0 >= 0 && cpu1 >= 0 ? cpu1 - cpu0 : -1;
 
   if (report->tracking.pose_valid) {
     const KeyFrameId ref = frame.reference_keyframe != kNoKeyFrame ? frame.reference_keyframe

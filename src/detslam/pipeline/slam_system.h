@@ -93,6 +93,9 @@ struct FrameTimings {
   // Of tracking_ms: the wait for the map's lock (held by local mapping or loop closing when they
   // run in another thread).
   double map_wait_ms = 0;
+  // The CPU time the tracking thread used for tracking_ms (its cost without waits and without
+  // time the other threads took the core from it; -1 where the platform cannot tell).
+  double tracking_cpu_ms = -1;
 };
 
 struct FrameReport {
