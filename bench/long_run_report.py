@@ -204,7 +204,7 @@ svg.append(panels.line([(r[1], r[4]) for r in plotted], y2, tops[1], "#c0392b"))
 y3 = max(max(r[2] for r in samples), 1) * 1.2
 svg += panels.axes(tops[2], y3, "keyframes", "#1a9850")
 svg.append(panels.line([(r[1], r[2]) for r in plotted], y3, tops[2], "#1a9850"))
-for name, f, _ in events:
+for name, f, _, _ in events:
     svg.append(f'<line x1="{panels.x(f):.1f}" x2="{panels.x(f):.1f}" y1="{tops[0]}" y2="{tops[2] + PH}" '
                f'stroke="#7b3294" stroke-dasharray="2,3"><title>{html.escape(name)}</title></line>')
 for k in range(6):
