@@ -245,7 +245,11 @@ TEST(ViewerServer, TheUpdateStreamSendsTheNewestFrameAndCountsItsClients) {
   std::future<std::string> stream = std::async(std::launch::async, [&] {
     return Get(server.port(), "/api/events");  // read for 3 s
   });
-  std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  // The client counts once the server has taken the connection (on a loaded machine that can take
+  // longer than a moment; the stream is read for 3 s).
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::milliseconds(2500);
+  while (content.clients.load() == 0 && std::chrono::steady_clock::now() < deadline)
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
   EXPECT_EQ(content.clients.load(), 1);
   for (int i = 2; i <= 50; ++i) content.SetFrame(i);  // faster than a page reads them
   const std::string text = stream.get();
