@@ -5,7 +5,7 @@
 # seed), two runs of the same frames:
 #   offline   sequential, every frame segmented (the accuracy reference)
 #   live      `detslam run --realtime`: frames offered at their timestamps (30 fps), dropped when
-#             the pipeline is busy; threaded with the mapping thread; asynchronous segmentation
+#             the pipeline is busy; threaded with the mapping and loop-closing threads; asynchronous segmentation
 #   sync      the same with --sync-segmentation (each frame taken is segmented before extraction:
 #             the previous design, for comparison)
 # and reports, from the live run's own outputs (run.json and its trajectory, not a replay): frames
@@ -91,7 +91,7 @@ print(f"`detslam run --realtime` on synthetic walking sequences (people from the
       "default dnn segmenter (offline: YOLOX input 416, Segmentation.InputSize; camera rate: 256 (320 in runs before 2026-12-05 12:20), "
       "Segmentation.CameraRateInputSize, chosen on the tuning seeds 1-3: fresher masks; one OpenCV thread "
       "at camera rate, Segmentation.CameraRateOpenCvThreads, chosen on the same seeds; see the README), "
-      "threaded with the mapping thread. The camera offers each frame at its "
+      "threaded with the mapping and loop-closing threads (loop closing in its own thread since commit 7cfabb5). The camera offers each frame at its "
       "timestamp and holds one; a frame the pipeline has not taken when the next arrives is dropped. "
       "As a camera delivers decoded images, the frames are decoded from their PNG files before the "
       "camera starts (up to 2 GiB; all of these). Segmentation is asynchronous: the segmentation thread "
@@ -230,7 +230,7 @@ if want long; then
         "$work/long_eval.json")
   fi
   {
-    echo "\`detslam run --realtime\` (default dnn segmenter, threaded with the mapping thread) on $long_frames"
+    echo "\`detslam run --realtime\` (default dnn segmenter, threaded with the mapping and loop-closing threads) on $long_frames"
     echo "synthetic frames at 30 Hz ($((long_frames / 1800)) min $(((long_frames % 1800) / 30)) s): one lap of the \`loop_long\` preset"
     echo "(evaluation seed $long_seed; an ellipse of 9.0 x 5.2 m in the large office, 1920 frames = 64 s, the circuit"
     echo "closes exactly; people walk about) listed again and again with later timestamps"
