@@ -110,9 +110,10 @@ tenths = [med(window(k * offered // 10, (k + 1) * offered // 10), "tracking_ms")
 print(f"\nMedian tracking ms per tenth of the input frames: {' / '.join(f'{v:.1f}' for v in tenths)}"
       + (f"; CPU ms: {' / '.join(f'{v:.1f}' for v in (med(window(k * offered // 10, (k + 1) * offered // 10), 'tracking_cpu_ms') for k in range(10)))}"
          if has_cpu else "")
-      + " (the tracker's local map, the keyframes that see the frame's points and their best covisibles, "
-      f"is capped at 80 keyframes (TrackerOptions::max_local_keyframes) as in ORB-SLAM3: the cost grows while the map "
-      f"fills up to it, then stays; the wall clock also grows with the work of the mapping threads that share the "
+      + " (the tracker's cost follows the size of its local map, the keyframes that see the frame's points "
+      f"and their best covisibles (at most 80, TrackerOptions::max_local_keyframes, as in ORB-SLAM3"
+      f"): it grows while later laps add keyframes where earlier laps made some, and stays once keyframe culling "
+      f"keeps their number; the wall clock also grows with the work of the mapping threads that share the "
       f"two cores).")
 print()
 print(f"Memory (resident, sampled twice a second): {start[4]:.0f} MiB at the first sample (frame "
