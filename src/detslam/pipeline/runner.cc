@@ -221,7 +221,7 @@ class RunRecorder {
     summary_.tracking = ComputeErrorStats(trk_);
     summary_.mapping = ComputeErrorStats(slam.mapping_times_ms());
     summary_.loop_closing = ComputeErrorStats(slam.loop_closing_times_ms());
-    summary_.loop_thread = options.threaded && options.mapping_thread && options.loop_thread;
+    summary_.loop_thread = slam.loop_thread();
     summary_.total = ComputeErrorStats(total_ms_);
     summary_.latency = ComputeErrorStats(latency_);
     summary_.latency_p99_ms = Percentile(latency_, 99);

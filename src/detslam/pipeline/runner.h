@@ -159,8 +159,8 @@ RunSummary RunSequential(const RgbdSource& dataset, const Settings& settings,
 // With options.mapping_thread, local mapping runs in a fourth thread fed by a keyframe queue
 // (results then depend on timing), and with options.loop_thread loop closing in a fifth, fed by
 // the keyframes local mapping finished; without mapping_thread, mapping and loop closing run in
-// the tracking thread and the trajectory equals the sequential one. An exception in any stage stops the others and is
-// rethrown here.
+// the tracking thread and the trajectory equals the sequential one. An exception in any stage
+// stops the others and is rethrown here.
 RunSummary RunThreaded(const RgbdSource& dataset, const Settings& settings,
                        const RunOptions& options, const ProgressFn& progress = nullptr,
                        Segmenter* segmenter = nullptr);

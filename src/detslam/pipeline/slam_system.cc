@@ -180,8 +180,8 @@ void SlamSystem::CloseLoops(KeyFrameId kf, FrameReport* report) {
     if (!options_.loop_thread) return;
     const auto w0 = std::chrono::steady_clock::now();
     turn.lock();
+    wait_ms = MsSince(w0);
     held_since = std::chrono::steady_clock::now();
-    wait_ms = std::chrono::duration<double, std::milli>(held_since - w0).count();
   };
   loop_closer_.Process(run_step, kf, finish, moved, hold_mapping);
   const double held_ms = turn.owns_lock() ? MsSince(held_since) : 0.0;

@@ -236,6 +236,8 @@ class SlamSystem {
   // Writes the map to a map file (map/map_file.h) with this run's camera, pyramid and vocabulary
   // checksum, atomically; returns the file's size in bytes. Throws InputError on failure.
   uint64_t SaveMap(const std::string& path) const;
+  // Whether loop closing runs in a thread of its own (SlamOptions::loop_thread).
+  bool loop_thread() const { return options_.loop_thread; }
   // The vocabulary file in use ("none" without place recognition).
   const std::string& vocabulary_path() const { return vocabulary_path_; }
 
