@@ -112,9 +112,11 @@ print(f"\nMedian tracking ms per tenth of the input frames: {' / '.join(f'{v:.1f
          if has_cpu else "")
       + " (the tracker's cost follows the size of its local map, the keyframes that see the frame's points "
       f"and their best covisibles (at most 80, TrackerOptions::max_local_keyframes, as in ORB-SLAM3"
-      f"): it grows while later laps add keyframes where earlier laps made some, and stays once keyframe culling "
-      f"keeps their number; the wall clock also grows with the work of the mapping threads that share the "
-      f"two cores).")
+      f"): it grows from the first lap to the second, where the frame's points are also seen by the keyframes "
+      f"ahead of the camera that the first lap made after passing there, and by those the second lap adds, "
+      f"and more of them are tracked; it stays once keyframe culling keeps their number (docs/STATUS.md "
+      f"breaks this down on a tuning seed); the wall clock also grows with the work of the mapping threads "
+      f"that share the two cores).")
 print()
 print(f"Memory (resident, sampled twice a second): {start[4]:.0f} MiB at the first sample (frame "
       f"{start[1]}, {start[2]} keyframes), {s10[4]:.0f} at 10 %, {s50[4]:.0f} at 50 %, {end[4]:.0f} at "
