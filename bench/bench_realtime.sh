@@ -5,7 +5,8 @@
 # seed), two runs of the same frames:
 #   offline   sequential, every frame segmented (the accuracy reference)
 #   live      `detslam run --realtime`: frames offered at their timestamps (30 fps), dropped when
-#             the pipeline is busy; threaded with the mapping and loop-closing threads; asynchronous segmentation
+#             the pipeline is busy; threaded with the mapping and loop-closing threads;
+#             asynchronous segmentation
 #   sync      the same with --sync-segmentation (each frame taken is segmented before extraction:
 #             the previous design, for comparison)
 # and reports, from the live run's own outputs (run.json and its trajectory, not a replay): frames

@@ -106,10 +106,11 @@ for name, a, b in rows:
     print(f"| {name} | {fmt(a)} | {fmt(b)} | {b / a if a else float('nan'):.2f} |")
 ratio = med(last, "tracking_ms") / med(first, "tracking_ms")
 cpu_ratio = med(last, "tracking_cpu_ms") / med(first, "tracking_cpu_ms") if has_cpu else float("nan")
-tenths = [med(window(k * offered // 10, (k + 1) * offered // 10), "tracking_ms") for k in range(10)]
+tenth_frames = [window(k * offered // 10, (k + 1) * offered // 10) for k in range(10)]
+tenths = [med(t, "tracking_ms") for t in tenth_frames]
+cpu_tenths = [med(t, "tracking_cpu_ms") for t in tenth_frames] if has_cpu else []
 print(f"\nMedian tracking ms per tenth of the input frames: {' / '.join(f'{v:.1f}' for v in tenths)}"
-      + (f"; CPU ms: {' / '.join(f'{v:.1f}' for v in (med(window(k * offered // 10, (k + 1) * offered // 10), 'tracking_cpu_ms') for k in range(10)))}"
-         if has_cpu else "")
+      + (f"; CPU ms: {' / '.join(f'{v:.1f}' for v in cpu_tenths)}" if has_cpu else "")
       + " (the tracker's cost follows the size of its local map, the keyframes that see the frame's points "
       f"and their best covisibles (at most 80, TrackerOptions::max_local_keyframes, as in ORB-SLAM3"
       f"): it grows from the first lap to the second, where the frame's points are also seen by the keyframes "
