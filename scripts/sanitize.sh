@@ -86,8 +86,9 @@ if [ $# -eq 0 ]; then
   else
     # Not the second-signal test: it quits with _exit while threads run, by design, which
     # ThreadSanitizer reports as a thread leak.
-    # The viewer's server and its live content: the runner's thread, the server's threads.
-    set -- -R "BoundedQueue|StageThreads|ViewerServer|LiveViewer|IntegrationRunner|IntegrationInterrupt|DataSlamFr2Desk.(ThreadedRunner|MappingThread)" \
+    # The viewer's server and its live content: the runner's thread, the server's threads. The
+    # map store's lock (tracking's access first).
+    set -- -R "MapStore|BoundedQueue|StageThreads|ViewerServer|LiveViewer|IntegrationRunner|IntegrationInterrupt|DataSlamFr2Desk.(ThreadedRunner|MappingThread)" \
       -E "ASecondSignal"
   fi
 fi

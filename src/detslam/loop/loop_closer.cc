@@ -104,7 +104,7 @@ LoopClosingResult LoopCloser::Process(const StepRunner& run_step, KeyFrameId kf_
                        (best && (!by_appearance ||
                                  best->coincidences >= options_.consistent_detections));
   if (closing && before_closing) before_closing();
-  std::optional<Correction> welding;  // a merge whose seam's bundle is solved between two steps
+  std::optional<Correction> work;  // a correction with solves left, between steps
   run_step([&](Map& map) {
     // By appearance, the candidate most keyframes agree with replaces a pending loop that fewer
     // agree with.
@@ -117,24 +117,29 @@ LoopClosingResult LoopCloser::Process(const StepRunner& run_step, KeyFrameId kf_
       Correction c;
       if (Close(map, kf_id, *to_close, &result, &c)) {
         if (moved) {
-          moved(map, c.before_merge);
+          moved(map, c.jumped_from);
           c.tracker_moved = true;
         }
-        welding = std::move(c);
-        return;  // `finish` once the weld is applied
+        work = std::move(c);
+        return;  // `finish` once the correction is applied
       }
     }
     if (finish) finish(map, result);
   });
-  if (!welding) return result;
-  // The seam's bundle adjustment without the map (ORB-SLAM3 stops local mapping for its
-  // MergeLocal; here tracking goes on and what it adds meanwhile is taken as it is).
-  BundleOptions bo;
-  bo.max_iterations = options_.merge_weld_iterations;
-  const BundleSummary weld = SolveBundle(camera_, &welding->weld->problem, bo);
+  if (!work) return result;
+  // The solves without the map (ORB-SLAM3 stops local mapping for its MergeLocal and holds the
+  // map for the essential graph; here tracking goes on and what it adds meanwhile is taken as it
+  // is).
+  if (work->weld) {
+    BundleOptions bo;
+    bo.max_iterations = options_.merge_weld_iterations;
+    const BundleSummary weld = SolveBundle(camera_, &work->weld->problem, bo);
+    run_step([&](Map& map) { BuildEssentialGraph(map, kf_id, &*work, &weld, &result); });
+  }
+  const PoseGraphSummary s = SolvePoseGraph(&*work->graph, PoseGraphOptions());
   run_step([&](Map& map) {
-    FinishCorrection(map, kf_id, &*welding, &weld, &result);
-    FinishMerge(*welding, kf_id, &result);
+    ApplyEssentialGraph(map, kf_id, &*work, s, &result);
+    Conclude(&*work, kf_id, &result);
     if (finish) finish(map, result);
   });
   return result;
@@ -171,15 +176,7 @@ bool LoopCloser::Close(Map& map, KeyFrameId kf_id, const Verified& loop,
     return false;
   }
   BeginCorrection(map, kf_id, c, result);
-  FinishCorrection(map, kf_id, c, nullptr, result);
-  result->closed = true;
-  ++loops_closed_;
-  spdlog::info(
-      "loop closed: keyframe {} with keyframe {} ({} inliers, {} keyframes agree, {} landmarks "
-      "fused, correction {:.3f} m)",
-      kf_id, loop.candidate, loop.inliers, loop.coincidences, result->fused,
-      result->correction_m);
-  return false;
+  return true;
 }
 
 bool LoopCloser::Merge(Map& map, KeyFrameId kf_id, Verified loop, LoopClosingResult* result,
@@ -201,28 +198,36 @@ bool LoopCloser::Merge(Map& map, KeyFrameId kf_id, Verified loop, LoopClosingRes
   loop.correction = loop.cam_from_world.Inverse() * map.keyframe(kf_id).cam_from_world;
   c->loop = std::move(loop);
   for (const auto& [id, pose] : c->before_merge) c->moved.insert(id);
+  c->jumped_from = c->before_merge;
   BeginCorrection(map, kf_id, c, result);
-  if (c->weld) return true;
-  FinishCorrection(map, kf_id, c, nullptr, result);
-  FinishMerge(*c, kf_id, result);
-  return false;
+  for (const auto& [id, pose] : c->before_merge) c->jumped_to[id] = c->old_pose.at(id);
+  return true;
 }
 
-void LoopCloser::FinishMerge(const Correction& c, KeyFrameId kf_id, LoopClosingResult* result) {
-  // The tracker moves its last frame from the poses before the merge, unless MovedFn already did.
-  if (!c.tracker_moved) {
-    for (const auto& [id, pose] : c.before_merge) result->old_poses[id] = pose;
-  }
+void LoopCloser::Conclude(Correction* c, KeyFrameId kf_id, LoopClosingResult* result) {
+  // The keyframes of the first step's move: the tracker moved with them then (MovedFn), or it
+  // moves now from their poses before it.
+  for (const auto& [id, pose] : c->jumped_from)
+    result->old_poses[id] = c->tracker_moved ? c->jumped_to.at(id) : pose;
   result->closed = true;
+  if (!c->merge) {
+    ++loops_closed_;
+    spdlog::info(
+        "loop closed: keyframe {} with keyframe {} ({} inliers, {} keyframes agree, {} landmarks "
+        "fused, correction {:.3f} m)",
+        kf_id, c->loop.candidate, c->loop.inliers, c->loop.coincidences, result->fused,
+        result->correction_m);
+    return;
+  }
   result->merged = true;
-  result->merged_from = c.merged_from;
-  result->merged_into = c.merged_into;
+  result->merged_from = c->merged_from;
+  result->merged_into = c->merged_into;
   ++maps_merged_;
   spdlog::info(
       "maps merged: map {} into map {} at keyframe {} with keyframe {} ({} inliers, {} keyframes "
       "agree, {} landmarks fused, {} keyframes welded, seam correction {:.3f} m)",
-      c.merged_from, c.merged_into, kf_id, c.loop.candidate, c.loop.inliers,
-      c.loop.coincidences, result->fused, result->welded_keyframes, result->correction_m);
+      c->merged_from, c->merged_into, kf_id, c->loop.candidate, c->loop.inliers,
+      c->loop.coincidences, result->fused, result->welded_keyframes, result->correction_m);
 }
 
 bool LoopCloser::WithinRadius(const Map& map, KeyFrameId kf_id, KeyFrameId other) const {
@@ -349,6 +354,18 @@ int OptimiseAssociations(const PinholeCamera& camera, const Map& map, const Fram
     if (!r.inliers[k]) (*assoc)[idx[k]] = kNoLandmark;
   }
   return r.num_inliers;
+}
+
+// The keyframe a landmark moves with in a correction: its reference keyframe, else (erased, or
+// without a pose in `poses`) its first observer; kNoKeyFrame when that has none in `poses` either.
+KeyFrameId LandmarkAnchor(const Map& map, LandmarkId id, const std::map<KeyFrameId, Rigid3d>& poses) {
+  const Landmark& lm = map.landmark(id);
+  KeyFrameId ref = lm.reference_keyframe;
+  if (!map.HasKeyFrame(ref) || !poses.count(ref)) {
+    if (lm.observations.empty()) return kNoKeyFrame;
+    ref = lm.observations.begin()->first;
+  }
+  return poses.count(ref) ? ref : kNoKeyFrame;
 }
 
 ProjectionSearchOptions LoopProjectionOptions() {
@@ -489,7 +506,33 @@ void LoopCloser::BeginCorrection(Map& map, KeyFrameId kf_id, Correction* c,
                                        fuse, FuseWinner::kSource);
   }
   for (KeyFrameId g : c->group) map.UpdateConnections(g);
-  if (!c->correct_poses || !c->merge || options_.merge_weld_keyframes <= 0) return;
+  c->moved_from = c->old_pose;
+  if (!c->correct_poses) return;
+  if (!c->merge) {
+    // ORB-SLAM's CorrectLoop: the neighbourhood and the landmarks it made move to the loop's frame
+    // now, so that tracking, until the pose graph is applied, sees one copy of the place, not the
+    // loop side's landmarks next to the neighbourhood's at their drifted positions.
+    const std::set<KeyFrameId> in_group(c->group.begin(), c->group.end());
+    for (KeyFrameId g : c->group) {
+      c->jumped_from[g] = c->old_pose.at(g);
+      map.keyframe(g).cam_from_world = c->moved_from[g] = c->jumped_to[g] = c->initial.at(g);
+    }
+    for (auto& [id, pos] : c->old_position) {
+      if (!map.HasLandmark(id)) continue;  // fused into a loop side's landmark
+      const KeyFrameId anchor = LandmarkAnchor(map, id, c->old_pose);
+      if (!in_group.count(anchor)) continue;
+      Landmark& lm = map.landmark(id);
+      pos = lm.position =
+          c->initial.at(anchor).Inverse() * (c->old_pose.at(anchor) * lm.position);
+      map.UpdateLandmarkGeometry(id);
+    }
+    BuildEssentialGraph(map, kf_id, c, nullptr, result);
+    return;
+  }
+  if (options_.merge_weld_keyframes <= 0) {
+    BuildEssentialGraph(map, kf_id, c, nullptr, result);
+    return;
+  }
 
   // A merge's seam (ORB-SLAM3's MergeLocal): the moved map's side (its seam keyframe and best
   // covisibles of its own map; after the fusion they may reach across the seam) is
@@ -507,13 +550,15 @@ void LoopCloser::BeginCorrection(Map& map, KeyFrameId kf_id, Correction* c,
   const std::vector<KeyFrameId> adjust = side_of(kf_moved ? kf_id : loop.candidate, true);
   const std::vector<KeyFrameId> held = side_of(kf_moved ? loop.candidate : kf_id, false);
   MapBundle bundle = BuildWindowBundle(map, adjust, static_cast<int>(side), held);
-  if (!bundle.problem.poses.empty() && !bundle.problem.observations.empty())
+  if (!bundle.problem.poses.empty() && !bundle.problem.observations.empty()) {
     c->weld = std::move(bundle);
+  } else {
+    BuildEssentialGraph(map, kf_id, c, nullptr, result);
+  }
 }
 
-void LoopCloser::FinishCorrection(Map& map, KeyFrameId kf_id, Correction* c,
-                                  const BundleSummary* weld, LoopClosingResult* result) {
-  if (!c->correct_poses) return;
+void LoopCloser::BuildEssentialGraph(Map& map, KeyFrameId kf_id, Correction* c,
+                                     const BundleSummary* weld, LoopClosingResult* result) {
   const Verified& loop = c->loop;
   // Keyframes and landmarks that tracking made since BeginCorrection (a welded merge, between
   // its steps) are taken where they are; the pose graph moves those keyframes with the
@@ -521,7 +566,7 @@ void LoopCloser::FinishCorrection(Map& map, KeyFrameId kf_id, Correction* c,
   std::set<KeyFrameId> made_meanwhile;
   for (const auto& [id, k] : map.keyframes()) {
     if (c->old_pose.emplace(id, k.cam_from_world).second) {
-      c->initial[id] = k.cam_from_world;
+      c->initial[id] = c->moved_from[id] = k.cam_from_world;
       made_meanwhile.insert(id);
     }
   }
@@ -531,7 +576,6 @@ void LoopCloser::FinishCorrection(Map& map, KeyFrameId kf_id, Correction* c,
   // graph, with that window and the kept map fixed, bends the rest of the moved map to it. The
   // landmarks then move with their reference keyframes from the poses and positions after the
   // weld (`moved_from`); the edges keep the relative poses from before it.
-  std::map<KeyFrameId, Rigid3d> moved_from = c->old_pose;
   std::set<KeyFrameId> welded;
   if (c->weld && weld) {
     if (weld->usable) {
@@ -542,7 +586,7 @@ void LoopCloser::FinishCorrection(Map& map, KeyFrameId kf_id, Correction* c,
       spdlog::warn("merge: the seam's bundle adjustment failed; the pose graph alone welds it");
     }
   }
-  for (KeyFrameId k : welded) c->initial[k] = moved_from[k] = map.keyframe(k).cam_from_world;
+  for (KeyFrameId k : welded) c->initial[k] = c->moved_from[k] = map.keyframe(k).cam_from_world;
   if (!welded.empty()) {
     for (auto& [id, pos] : c->old_position)
       if (map.HasLandmark(id)) pos = map.landmark(id).position;
@@ -589,28 +633,66 @@ void LoopCloser::FinishCorrection(Map& map, KeyFrameId kf_id, Correction* c,
       if (w >= options_.essential_min_weight) add_edge(id, n, c->old_pose);
     }
   }
-  const PoseGraphSummary s = SolvePoseGraph(&problem, PoseGraphOptions());
+  c->graph = std::move(problem);
+}
+
+void LoopCloser::ApplyEssentialGraph(Map& map, KeyFrameId kf_id, Correction* c,
+                                     const PoseGraphSummary& s, LoopClosingResult* result) {
   if (!s.usable)
     spdlog::warn("loop closing: pose graph optimisation did not converge; using its last state");
-  for (const PoseGraphProblem::Node& n : problem.nodes)
-    map.keyframe(n.id).cam_from_world = n.cam_from_world;
+  // Keyframes and landmarks made since the graph was built (tracking went on while it was
+  // solved): taken where they are, then moved with the keyframes they were made from.
+  std::vector<KeyFrameId> made_since;
+  for (const auto& [id, k] : map.keyframes()) {
+    if (c->old_pose.emplace(id, k.cam_from_world).second) {
+      c->moved_from[id] = k.cam_from_world;
+      made_since.push_back(id);
+    }
+  }
+  for (const auto& [id, lm] : map.landmarks()) c->old_position.emplace(id, lm.position);
+  // `before`: each keyframe's pose in the map before this step.
+  std::map<KeyFrameId, Rigid3d> before;
+  std::set<KeyFrameId> corrected;
+  for (const PoseGraphProblem::Node& n : c->graph->nodes) {
+    if (!map.HasKeyFrame(n.id)) continue;
+    Rigid3d& pose = map.keyframe(n.id).cam_from_world;
+    before[n.id] = pose;
+    pose = n.cam_from_world;
+    corrected.insert(n.id);
+  }
+  // In id order, so that a keyframe's parent, older, has moved before it.
+  std::sort(made_since.begin(), made_since.end());
+  for (KeyFrameId id : made_since) {
+    KeyFrame& k = map.keyframe(id);
+    before[id] = k.cam_from_world;
+    KeyFrameId anchor = corrected.count(k.parent) ? k.parent : kNoKeyFrame;
+    if (anchor == kNoKeyFrame) {
+      for (KeyFrameId n : map.BestCovisibles(id, 1000)) {
+        if (corrected.count(n)) {
+          anchor = n;
+          break;
+        }
+      }
+    }
+    if (anchor == kNoKeyFrame) continue;
+    k.cam_from_world =
+        k.cam_from_world * before.at(anchor).Inverse() * map.keyframe(anchor).cam_from_world;
+    corrected.insert(id);
+  }
 
   // Every landmark moves with its reference keyframe.
   for (const auto& [id, pos] : c->old_position) {
     if (!map.HasLandmark(id)) continue;
+    const KeyFrameId anchor = LandmarkAnchor(map, id, c->moved_from);
+    if (anchor == kNoKeyFrame) continue;
     Landmark& lm = map.landmark(id);
-    KeyFrameId ref = lm.reference_keyframe;
-    if (!map.HasKeyFrame(ref) || !moved_from.count(ref)) {
-      if (lm.observations.empty()) continue;
-      ref = lm.observations.begin()->first;
-    }
-    if (!moved_from.count(ref)) continue;
-    lm.position = map.keyframe(ref).cam_from_world.Inverse() * (moved_from.at(ref) * pos);
+    lm.position = map.keyframe(anchor).cam_from_world.Inverse() * (c->moved_from.at(anchor) * pos);
     map.UpdateLandmarkGeometry(id);
   }
   result->correction_m =
       (map.keyframe(kf_id).Center() - c->old_pose.at(kf_id).Inverse().translation()).norm();
-  // The poses before this step (old_pose holds those made meanwhile too), for the tracker.
+  // For the tracker: each keyframe's pose as it was when the tracker last moved with the map
+  // (those made meanwhile: as tracking made them); Conclude sets those of the first step's move.
   result->old_poses = std::move(c->old_pose);
 }
 

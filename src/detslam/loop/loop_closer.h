@@ -36,6 +36,7 @@
 #include "detslam/map/place_candidates.h"
 #include "detslam/map/projection_search.h"
 #include "detslam/mapping/map_bundle.h"
+#include "detslam/optim/pose_graph.h"
 
 namespace detslam {
 
@@ -120,19 +121,21 @@ class LoopCloser {
   // Called in the last step of Process, under the same access as the correction (e.g. to move the
   // tracker's state with the map), whether a loop was closed or not.
   using FinishFn = std::function<void(Map&, const LoopClosingResult&)>;
-  // A merge whose seam is welded moves the map in two steps: the first (the maps joined in one
-  // frame, the seam fused) calls this under its access with the moved keyframes' poses before it
-  // (e.g. to move the tracker's last frame, and to mark a global BA started earlier as stale);
-  // the welding bundle adjustment is then solved without the map (tracking goes on), and the
-  // second step applies it, bends the rest of the moved map (pose graph) and calls `finish`.
+  // A correction moves the map in steps, with the solves between them done without the map
+  // (tracking goes on). The first step moves part of the map at once (a loop: the keyframe's
+  // neighbourhood to the loop's frame; a merge: the moved map into the kept map's frame) and calls
+  // this under its access with those keyframes' poses before it (e.g. to move the tracker's last
+  // frame, and to mark a global BA started earlier as stale); a welded merge's seam bundle
+  // adjustment and then the pose graph are solved without the map, each applied in a step of its
+  // own, and the last step moves the landmarks and calls `finish`.
   using MovedFn = std::function<void(Map&, const std::map<KeyFrameId, Rigid3d>& old_poses)>;
 
   // Looks for and closes a loop at keyframe `kf` of `map`. Deterministic.
   LoopClosingResult Process(Map& map, KeyFrameId kf);
   // The same in steps, each run by `run_step` (so a lock can be released between them and
   // tracking does not wait for the whole search): the candidate search, each candidate's
-  // verification, then the closing (fusion, pose graph) with `finish` (a welded merge: two
-  // steps, the seam's bundle adjustment solved between them, see MovedFn). Between steps tracking
+  // verification, then the closing (fusion, pose graph) with `finish`, in two or three steps with
+  // the solves between them (see MovedFn). Between steps tracking
   // may add keyframes and points, and until `before_closing` a local-mapping thread may also
   // erase and move them: every step checks again that the keyframes it uses exist, and results
   // carried across steps refer to landmarks by id and are checked again. With nothing else
@@ -163,9 +166,12 @@ class LoopCloser {
     int coincidences = 0;  // keyframes that agree (appearance only)
     int misses = 0;        // next keyframes in a row that did not
   };
-  // A correction between its two parts (BeginCorrection: fusion, and for a merge the seam's
-  // bundle built; FinishCorrection: the weld applied, the pose graph, the landmarks moved), which
-  // a welded merge runs in two steps with the bundle solved between them.
+  // A correction in steps, each under the caller's access, with the two solves between them
+  // without the map (tracking goes on): BeginCorrection (fusion; a loop's neighbourhood moved
+  // rigidly to the loop's frame; for a welded merge the seam's bundle built), the weld solved,
+  // BuildEssentialGraph (the weld applied, the pose graph built), the pose graph solved,
+  // ApplyEssentialGraph (the poses set, keyframes made meanwhile moved with their parents, the
+  // landmarks moved with their reference keyframes).
   struct Correction {
     Verified loop;
     bool correct_poses = true;  // false: a revisit (fusion only)
@@ -173,13 +179,20 @@ class LoopCloser {
     int merged_from = -1, merged_into = -1;
     std::set<KeyFrameId> moved;                  // a merge: the moved map's keyframes
     std::map<KeyFrameId, Rigid3d> before_merge;  // and their poses before the move
-    bool tracker_moved = false;  // MovedFn was called with before_merge
-    std::map<KeyFrameId, Rigid3d> old_pose;      // every keyframe's pose before the correction
+    // The first step's move (a merge: the moved map; a loop: its group): the poses before it (for
+    // MovedFn) and after it; tracker_moved: MovedFn was called.
+    std::map<KeyFrameId, Rigid3d> jumped_from, jumped_to;
+    bool tracker_moved = false;
+    std::map<KeyFrameId, Rigid3d> old_pose;  // every keyframe's pose before the correction
     std::map<LandmarkId, Eigen::Vector3d> old_position;
+    // The keyframe pose each landmark's old_position is relative to (old_pose, except where a
+    // step before the pose graph already moved the keyframe with its landmarks).
+    std::map<KeyFrameId, Rigid3d> moved_from;
     std::vector<KeyFrameId> group;  // the keyframe and its covisibles, moved rigidly with it
     std::map<KeyFrameId, std::set<KeyFrameId>> connected_before;
     std::map<KeyFrameId, Rigid3d> initial;  // the pose graph's starting poses
     std::optional<MapBundle> weld;          // the seam's bundle, to solve
+    std::optional<PoseGraphProblem> graph;  // the essential graph, to solve
   };
   bool WithinRadius(const Map& map, KeyFrameId kf, KeyFrameId other) const;
   std::vector<KeyFrameId> CandidatesByPosition(const Map& map, KeyFrameId kf) const;
@@ -200,24 +213,32 @@ class LoopCloser {
   // Appearance: a pending loop checked against the new keyframe `kf`; true if it agrees (then the
   // pending loop is re-verified at kf).
   bool ConfirmPending(const Map& map, KeyFrameId kf);
-  // Closes the verified loop (or merges the maps). Returns true when a merge's seam bundle is left
-  // to solve (c->weld): the caller solves it, then FinishCorrection and FinishMerge.
+  // Closes the verified loop (or merges the maps) up to what is solved without the map: returns
+  // true when c->weld or c->graph is left to solve (then BuildEssentialGraph after a weld,
+  // ApplyEssentialGraph and Conclude); false for a revisit.
   bool Close(Map& map, KeyFrameId kf, const Verified& loop, LoopClosingResult* result,
              Correction* c);
   // A verified candidate in another map: moves the map whose root is newer into the other's frame
-  // (Map::MergeMapInto), then corrects (welds) the seam; true as for Close.
+  // (Map::MergeMapInto), then corrects (welds) the seam; returns as Close.
   bool Merge(Map& map, KeyFrameId kf, Verified loop, LoopClosingResult* result, Correction* c);
-  void FinishMerge(const Correction& c, KeyFrameId kf, LoopClosingResult* result);
-  // Fuses the loop side's landmarks into kf's neighbourhood and, with c->correct_poses and a merge
-  // with merge_weld_keyframes > 0, builds the bundle of the moved map's side of the seam against
-  // the kept map's (c->weld; none when it would be empty).
+  // Fuses the loop side's landmarks into kf's neighbourhood. With c->correct_poses: a loop moves
+  // that neighbourhood (c->group) and the landmarks it made to the loop's frame at once (ORB-SLAM's
+  // CorrectLoop), so tracking meets one consistent place until the pose graph is applied; a merge
+  // with merge_weld_keyframes > 0 builds the bundle of the moved map's side of the seam against
+  // the kept map's (c->weld; none when it would be empty); else the pose graph is built.
   void BeginCorrection(Map& map, KeyFrameId kf, Correction* c, LoopClosingResult* result);
-  // Applies the solved weld (`weld`: its summary, null when none was built), then the pose graph
-  // over the map (a merge's weld window and the kept map fixed), and moves every landmark with
-  // its reference keyframe. Keyframes and landmarks made since BeginCorrection are taken as they
-  // are.
-  void FinishCorrection(Map& map, KeyFrameId kf, Correction* c, const BundleSummary* weld,
-                        LoopClosingResult* result);
+  // Applies the solved weld (`weld`: its summary, null when none was built), then builds the
+  // essential graph (c->graph) over kf's map: spanning tree, strong covisibility, the new loop
+  // connections; a merge's weld window and the kept map fixed. Keyframes and landmarks made
+  // since BeginCorrection are taken as they are.
+  void BuildEssentialGraph(Map& map, KeyFrameId kf, Correction* c, const BundleSummary* weld,
+                           LoopClosingResult* result);
+  // Sets the solved graph's poses; keyframes made since it was built move with their parent (or
+  // best covisible) and every landmark with its reference keyframe.
+  void ApplyEssentialGraph(Map& map, KeyFrameId kf, Correction* c, const PoseGraphSummary& s,
+                           LoopClosingResult* result);
+  // The correction's bookkeeping once applied: counters, log, result->old_poses.
+  void Conclude(Correction* c, KeyFrameId kf, LoopClosingResult* result);
 
   PinholeCamera camera_;
   LoopClosingOptions options_;

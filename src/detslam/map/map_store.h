@@ -6,8 +6,16 @@
 //
 // Whoever holds a write access may also touch state that lives beside the map and is documented
 // as guarded by this lock (the tracker's state, the trajectory bookkeeping of SlamSystem).
+//
+// Tracking takes the map first (WriteFirst): an access that waits for the lock while tracking
+// does lets tracking have it before it, so a frame waits at most for the one step that holds the
+// map, not for a stage that releases the lock and takes it again at once (std::mutex is not fair:
+// a loop-closing thread verifying candidates one step each could otherwise hold tracking off for
+// several steps in a row).
 #pragma once
 
+#include <atomic>
+#include <condition_variable>
 #include <mutex>
 #include <optional>
 #include <utility>
@@ -28,11 +36,21 @@ class MapStore {
     Map& operator*() const { return *map_; }
     Map* operator->() const { return map_; }
 
+    ~WriteAccess() {
+      if (!first_) return;
+      lock_.unlock();
+      first_->notify_all();  // the accesses that let this one go first
+    }
+    WriteAccess(const WriteAccess&) = delete;
+    WriteAccess& operator=(const WriteAccess&) = delete;
+
    private:
     friend class MapStore;
-    WriteAccess(std::mutex& m, Map* map) : lock_(m), map_(map) {}
+    WriteAccess(std::unique_lock<std::mutex> lock, Map* map, std::condition_variable* first)
+        : lock_(std::move(lock)), map_(map), first_(first) {}
     std::unique_lock<std::mutex> lock_;
     Map* map_;
+    std::condition_variable* first_;  // set for WriteFirst
   };
   // Read-only access; excludes writers for its lifetime.
   class ReadAccess {
@@ -42,13 +60,21 @@ class MapStore {
 
    private:
     friend class MapStore;
-    ReadAccess(std::mutex& m, const Map* map) : lock_(m), map_(map) {}
+    ReadAccess(std::unique_lock<std::mutex> lock, const Map* map)
+        : lock_(std::move(lock)), map_(map) {}
     std::unique_lock<std::mutex> lock_;
     const Map* map_;
   };
 
-  WriteAccess Write() { return WriteAccess(mutex_, &map_); }
-  ReadAccess Read() const { return ReadAccess(mutex_, &map_); }
+  WriteAccess Write() { return WriteAccess(LockAfterFirst(), &map_, nullptr); }
+  ReadAccess Read() const { return ReadAccess(LockAfterFirst(), &map_); }
+  // Exclusive access ahead of the Write and Read accesses waiting for the lock (tracking's).
+  WriteAccess WriteFirst() {
+    ++first_waiting_;
+    std::unique_lock<std::mutex> lock(mutex_);
+    --first_waiting_;
+    return WriteAccess(std::move(lock), &map_, &first_done_);
+  }
 
   // The snapshot-solve-apply pattern. `snapshot(const Map&) -> std::optional<S>` runs under the
   // lock (nullopt: nothing to do); `solve(S&) -> R` runs without it; `apply(Map&, const S&,
@@ -68,7 +94,15 @@ class MapStore {
   }
 
  private:
+  std::unique_lock<std::mutex> LockAfterFirst() const {
+    std::unique_lock<std::mutex> lock(mutex_);
+    first_done_.wait(lock, [this] { return first_waiting_.load() == 0; });
+    return lock;
+  }
+
   mutable std::mutex mutex_;
+  mutable std::condition_variable first_done_;
+  mutable std::atomic<int> first_waiting_{0};
   Map map_;
 };
 

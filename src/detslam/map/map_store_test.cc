@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <chrono>
 #include <condition_variable>
 #include <stdexcept>
 #include <thread>
@@ -75,6 +76,32 @@ TEST(MapStore, SolveRunsWithoutTheLockAndApplySkipsWhatWasRemoved) {
   EXPECT_FALSE(map->HasLandmark(removed));
   ASSERT_TRUE(map->HasLandmark(kept));
   EXPECT_EQ(map->landmark(kept).position.x(), 5);
+}
+
+// A stage that takes the map again and again, one step at a time, lets tracking's WriteFirst in
+// after at most the step it is in and one that had already passed the check: std::mutex alone
+// promises nothing (the thread that unlocks usually takes the lock again at once).
+TEST(MapStore, WriteFirstGoesBeforeAStageThatTakesTheMapAgainAndAgain) {
+  MapStore store(TwoLevels());
+  std::atomic<int> steps{0};
+  std::atomic<bool> stop{false};
+  std::thread stage([&] {
+    while (!stop) {
+      const MapStore::WriteAccess map = store.Write();
+      std::this_thread::sleep_for(std::chrono::milliseconds(2));  // the step's work
+      ++steps;
+    }
+  });
+  while (steps < 3) std::this_thread::yield();
+  for (int frame = 0; frame < 20; ++frame) {
+    const int before = steps;
+    const MapStore::WriteAccess map = store.WriteFirst();
+    EXPECT_LE(steps - before, 2) << "frame " << frame;
+    map->AddLandmark(Eigen::Vector3d(0, 0, 1), kNoKeyFrame);
+  }
+  stop = true;
+  stage.join();
+  EXPECT_EQ(store.Read()->NumLandmarks(), 20u);
 }
 
 }  // namespace

@@ -357,7 +357,7 @@ Frame SlamSystem::ExtractFrame(int64_t index, Timestamp stamp, const cv::Mat& gr
 KeyFrameId SlamSystem::TrackFrame(Frame frame, FrameReport* report, Frame* tracked) {
   auto t0 = std::chrono::steady_clock::now();
   const double cpu0 = ThreadCpuMs();
-  const MapStore::WriteAccess access = store_.Write();
+  const MapStore::WriteAccess access = store_.WriteFirst();
   report->timings.map_wait_ms = MsSince(t0);
   Map& map = *access;
   const size_t kfs_before = map.NumKeyFrames();
