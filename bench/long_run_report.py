@@ -126,9 +126,12 @@ print(f"Memory (resident, sampled twice a second): {start[4]:.0f} MiB at the fir
       f"the {end[2] - start[2]} keyframes added, x 1000; an upper bound for the map's share).\n")
 
 # Stalls around loop corrections and global BA solutions applied.
+# A loop's window starts at its keyframe's frame: its search, verification and every step of the
+# correction come after it.
 events = [(f"loop {'merge' if l['merge'] else 'closed'} at keyframe {l['keyframe']} (frame {l['frame']})",
-           l["corrected_after_frame"], l.get("map_locked_ms"), l.get("mapping_held_ms")) for l in run["loops"]]
-events += [(f"global BA applied", f, None, None) for f in run["global_ba"].get("applied_after_frames", [])]
+           l["frame"], l["corrected_after_frame"], l.get("map_locked_ms"), l.get("mapping_held_ms"))
+          for l in run["loops"]]
+events += [(f"global BA applied", f - 2, f, None, None) for f in run["global_ba"].get("applied_after_frames", [])]
 loop_thread = bool(run.get("loop_closing_thread"))
 lc = run["timings"].get("loop_closing_per_keyframe", {})
 lm = run["timings"].get("local_mapping_per_keyframe", {})
@@ -138,12 +141,12 @@ print(f"Loop closing ran {'in a thread of its own' if loop_thread else 'in the l
       f"(max {lm.get('max_ms', float('nan')):.1f})"
       + (" without it" if loop_thread else " with it") + ".\n")
 worst_stall = 0.0
-print("Tracking around each loop correction and global bundle adjustment (frames tracked from 2 before "
-      "to 30 after it was applied):\n")
+print("Tracking around each loop correction and global bundle adjustment (frames tracked from the loop "
+      "keyframe's frame, or 2 before a global BA was applied, to 30 after it was applied):\n")
 print("| event | applied after frame | map locked by loop closing ms | local mapping held ms | longest tracking ms | longest latency ms |")
 print("|---|---:|---:|---:|---:|---:|")
-for name, f, locked, held in events:
-    w = window(f - 2, f + 31)
+for name, lo, f, locked, held in events:
+    w = window(lo, f + 31)
     longest = max((x["tracking_ms"] for x in w), default=float("nan"))
     lat = max((x["latency_ms"] for x in w), default=float("nan"))
     worst_stall = max(worst_stall, longest)
@@ -208,7 +211,7 @@ svg.append(panels.line([(r[1], r[4]) for r in plotted], y2, tops[1], "#c0392b"))
 y3 = max(max(r[2] for r in samples), 1) * 1.2
 svg += panels.axes(tops[2], y3, "keyframes", "#1a9850")
 svg.append(panels.line([(r[1], r[2]) for r in plotted], y3, tops[2], "#1a9850"))
-for name, f, _, _ in events:
+for name, _, f, _, _ in events:
     svg.append(f'<line x1="{panels.x(f):.1f}" x2="{panels.x(f):.1f}" y1="{tops[0]}" y2="{tops[2] + PH}" '
                f'stroke="#7b3294" stroke-dasharray="2,3"><title>{html.escape(name)}</title></line>')
 for k in range(6):

@@ -641,44 +641,21 @@ void LoopCloser::ApplyEssentialGraph(Map& map, KeyFrameId kf_id, Correction* c,
   if (!s.usable)
     spdlog::warn("loop closing: pose graph optimisation did not converge; using its last state");
   // Keyframes and landmarks made since the graph was built (tracking went on while it was
-  // solved): taken where they are, then moved with the keyframes they were made from.
-  std::vector<KeyFrameId> made_since;
+  // solved): taken where they are, then the keyframes moved with their parents (the graph's
+  // keyframes do not move with theirs) and the landmarks with their reference keyframes.
+  std::map<KeyFrameId, Rigid3d> before;  // every keyframe's pose before this step
   for (const auto& [id, k] : map.keyframes()) {
-    if (c->old_pose.emplace(id, k.cam_from_world).second) {
-      c->moved_from[id] = k.cam_from_world;
-      made_since.push_back(id);
-    }
+    before[id] = k.cam_from_world;
+    if (c->old_pose.emplace(id, k.cam_from_world).second) c->moved_from[id] = k.cam_from_world;
   }
   for (const auto& [id, lm] : map.landmarks()) c->old_position.emplace(id, lm.position);
-  // `before`: each keyframe's pose in the map before this step.
-  std::map<KeyFrameId, Rigid3d> before;
-  std::set<KeyFrameId> corrected;
+  std::set<KeyFrameId> solved;
   for (const PoseGraphProblem::Node& n : c->graph->nodes) {
     if (!map.HasKeyFrame(n.id)) continue;
-    Rigid3d& pose = map.keyframe(n.id).cam_from_world;
-    before[n.id] = pose;
-    pose = n.cam_from_world;
-    corrected.insert(n.id);
+    map.keyframe(n.id).cam_from_world = n.cam_from_world;
+    solved.insert(n.id);
   }
-  // In id order, so that a keyframe's parent, older, has moved before it.
-  std::sort(made_since.begin(), made_since.end());
-  for (KeyFrameId id : made_since) {
-    KeyFrame& k = map.keyframe(id);
-    before[id] = k.cam_from_world;
-    KeyFrameId anchor = corrected.count(k.parent) ? k.parent : kNoKeyFrame;
-    if (anchor == kNoKeyFrame) {
-      for (KeyFrameId n : map.BestCovisibles(id, 1000)) {
-        if (corrected.count(n)) {
-          anchor = n;
-          break;
-        }
-      }
-    }
-    if (anchor == kNoKeyFrame) continue;
-    k.cam_from_world =
-        k.cam_from_world * before.at(anchor).Inverse() * map.keyframe(anchor).cam_from_world;
-    corrected.insert(id);
-  }
+  MoveWithParents(solved, before, &map);
 
   // Every landmark moves with its reference keyframe.
   for (const auto& [id, pos] : c->old_position) {

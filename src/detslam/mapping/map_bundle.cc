@@ -96,10 +96,8 @@ int ApplyMapBundle(const MapBundle& bundle, const BundleSummary& summary, Map* m
   return erased;
 }
 
-void PropagateBundleCorrection(const MapBundle& bundle, const std::map<KeyFrameId, Rigid3d>& before,
-                               Map* map) {
-  std::set<KeyFrameId> solved;
-  for (const auto& p : bundle.problem.poses) solved.insert(p.id);
+void MoveWithParents(const std::set<KeyFrameId>& solved, const std::map<KeyFrameId, Rigid3d>& before,
+                     Map* map) {
   std::vector<KeyFrameId> queue;
   for (const auto& [map_id, root] : map->map_roots()) {  // every map's tree, from its root
     (void)map_id;
@@ -118,6 +116,13 @@ void PropagateBundleCorrection(const MapBundle& bundle, const std::map<KeyFrameI
           child_from_parent * map->keyframe(parent).cam_from_world;
     }
   }
+}
+
+void PropagateBundleCorrection(const MapBundle& bundle, const std::map<KeyFrameId, Rigid3d>& before,
+                               Map* map) {
+  std::set<KeyFrameId> solved;
+  for (const auto& p : bundle.problem.poses) solved.insert(p.id);
+  MoveWithParents(solved, before, map);
   std::set<LandmarkId> held;
   for (const auto& p : bundle.problem.points) held.insert(p.id);
   std::vector<LandmarkId> moved;
