@@ -358,7 +358,8 @@ int OptimiseAssociations(const PinholeCamera& camera, const Map& map, const Fram
 
 // The keyframe a landmark moves with in a correction: its reference keyframe, else (erased, or
 // without a pose in `poses`) its first observer; kNoKeyFrame when that has none in `poses` either.
-KeyFrameId LandmarkAnchor(const Map& map, LandmarkId id, const std::map<KeyFrameId, Rigid3d>& poses) {
+KeyFrameId LandmarkAnchor(const Map& map, LandmarkId id,
+                          const std::map<KeyFrameId, Rigid3d>& poses) {
   const Landmark& lm = map.landmark(id);
   KeyFrameId ref = lm.reference_keyframe;
   if (!map.HasKeyFrame(ref) || !poses.count(ref)) {

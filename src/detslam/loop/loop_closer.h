@@ -135,11 +135,11 @@ class LoopCloser {
   // The same in steps, each run by `run_step` (so a lock can be released between them and
   // tracking does not wait for the whole search): the candidate search, each candidate's
   // verification, then the closing (fusion, pose graph) with `finish`, in two or three steps with
-  // the solves between them (see MovedFn). Between steps tracking
-  // may add keyframes and points, and until `before_closing` a local-mapping thread may also
-  // erase and move them: every step checks again that the keyframes it uses exist, and results
-  // carried across steps refer to landmarks by id and are checked again. With nothing else
-  // changing the map between steps, the result equals Process(map, kf).
+  // the solves between them (see MovedFn). Between steps tracking may add keyframes and points,
+  // and until `before_closing` a local-mapping thread may also erase and move them: every step
+  // checks again that the keyframes it uses exist, and results carried across steps refer to
+  // landmarks by id and are checked again. With nothing else changing the map between steps, the
+  // result equals Process(map, kf).
   // `before_closing` (may be null) is called, outside any step, just before the step that closes
   // a loop or merges maps, i.e. only when one will be: e.g. to hold a local-mapping thread that
   // erases keyframes and runs bundle adjustments, until Process returns.

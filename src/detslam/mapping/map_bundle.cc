@@ -96,8 +96,8 @@ int ApplyMapBundle(const MapBundle& bundle, const BundleSummary& summary, Map* m
   return erased;
 }
 
-void MoveWithParents(const std::set<KeyFrameId>& solved, const std::map<KeyFrameId, Rigid3d>& before,
-                     Map* map) {
+void MoveWithParents(const std::set<KeyFrameId>& solved,
+                     const std::map<KeyFrameId, Rigid3d>& before, Map* map) {
   std::vector<KeyFrameId> queue;
   for (const auto& [map_id, root] : map->map_roots()) {  // every map's tree, from its root
     (void)map_id;

@@ -43,8 +43,8 @@ int ApplyMapBundle(const MapBundle& bundle, const BundleSummary& summary, Map* m
 // Keyframes not in `solved` move with their spanning-tree parent, every map's tree from its root
 // down (child_from_parent kept as in `before`: every keyframe's pose before the solved ones were
 // set), e.g. those created while a solution was computed without the map lock.
-void MoveWithParents(const std::set<KeyFrameId>& solved, const std::map<KeyFrameId, Rigid3d>& before,
-                     Map* map);
+void MoveWithParents(const std::set<KeyFrameId>& solved,
+                     const std::map<KeyFrameId, Rigid3d>& before, Map* map);
 
 // After ApplyMapBundle of a bundle built earlier: keyframes the bundle did not hold (created while
 // it was solved) move with their spanning-tree parent, landmarks it did not hold with their
