@@ -356,19 +356,6 @@ int OptimiseAssociations(const PinholeCamera& camera, const Map& map, const Fram
   return r.num_inliers;
 }
 
-// The keyframe a landmark moves with in a correction: its reference keyframe, else (erased, or
-// without a pose in `poses`) its first observer; kNoKeyFrame when that has none in `poses` either.
-KeyFrameId LandmarkAnchor(const Map& map, LandmarkId id,
-                          const std::map<KeyFrameId, Rigid3d>& poses) {
-  const Landmark& lm = map.landmark(id);
-  KeyFrameId ref = lm.reference_keyframe;
-  if (!map.HasKeyFrame(ref) || !poses.count(ref)) {
-    if (lm.observations.empty()) return kNoKeyFrame;
-    ref = lm.observations.begin()->first;
-  }
-  return poses.count(ref) ? ref : kNoKeyFrame;
-}
-
 ProjectionSearchOptions LoopProjectionOptions() {
   ProjectionSearchOptions po;
   po.window = 10;

@@ -118,6 +118,16 @@ void MoveWithParents(const std::set<KeyFrameId>& solved,
   }
 }
 
+KeyFrameId LandmarkAnchor(const Map& map, LandmarkId id, const std::map<KeyFrameId, Rigid3d>& poses) {
+  const Landmark& lm = map.landmark(id);
+  KeyFrameId ref = lm.reference_keyframe;
+  if (!map.HasKeyFrame(ref) || !poses.count(ref)) {
+    if (lm.observations.empty()) return kNoKeyFrame;
+    ref = lm.observations.begin()->first;
+  }
+  return map.HasKeyFrame(ref) && poses.count(ref) ? ref : kNoKeyFrame;
+}
+
 void PropagateBundleCorrection(const MapBundle& bundle, const std::map<KeyFrameId, Rigid3d>& before,
                                Map* map) {
   std::set<KeyFrameId> solved;
@@ -125,19 +135,16 @@ void PropagateBundleCorrection(const MapBundle& bundle, const std::map<KeyFrameI
   MoveWithParents(solved, before, map);
   std::set<LandmarkId> held;
   for (const auto& p : bundle.problem.points) held.insert(p.id);
-  std::vector<LandmarkId> moved;
-  for (auto& [id, lm] : map->landmarks()) {
+  std::vector<std::pair<LandmarkId, KeyFrameId>> moved;
+  for (const auto& [id, lm] : map->landmarks()) {
+    (void)lm;
     if (held.count(id)) continue;
-    KeyFrameId ref = lm.reference_keyframe;
-    if (!map->HasKeyFrame(ref) && !lm.observations.empty()) ref = lm.observations.begin()->first;
-    if (!map->HasKeyFrame(ref) || !before.count(ref)) continue;
-    moved.push_back(id);
+    const KeyFrameId anchor = LandmarkAnchor(*map, id, before);
+    if (anchor != kNoKeyFrame) moved.emplace_back(id, anchor);
   }
-  for (LandmarkId id : moved) {
+  for (const auto& [id, anchor] : moved) {
     Landmark& lm = map->landmark(id);
-    KeyFrameId ref = lm.reference_keyframe;
-    if (!map->HasKeyFrame(ref)) ref = lm.observations.begin()->first;
-    lm.position = map->keyframe(ref).cam_from_world.Inverse() * (before.at(ref) * lm.position);
+    lm.position = map->keyframe(anchor).cam_from_world.Inverse() * (before.at(anchor) * lm.position);
     map->UpdateLandmarkGeometry(id);
   }
 }

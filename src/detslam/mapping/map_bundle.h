@@ -46,6 +46,11 @@ int ApplyMapBundle(const MapBundle& bundle, const BundleSummary& summary, Map* m
 void MoveWithParents(const std::set<KeyFrameId>& solved,
                      const std::map<KeyFrameId, Rigid3d>& before, Map* map);
 
+// The keyframe a landmark moves with in a correction: its reference keyframe, else (erased, or
+// without a pose in `poses`) its first observer; kNoKeyFrame when that is not in the map or has no
+// pose in `poses` either.
+KeyFrameId LandmarkAnchor(const Map& map, LandmarkId id, const std::map<KeyFrameId, Rigid3d>& poses);
+
 // After ApplyMapBundle of a bundle built earlier: keyframes the bundle did not hold (created while
 // it was solved) move with their spanning-tree parent, landmarks it did not hold with their
 // reference keyframe (else their first observer). `before`: every keyframe's pose before
