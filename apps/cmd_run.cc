@@ -40,6 +40,7 @@ struct RunArgs {
   bool realtime = false;  // --realtime: frames offered at their timestamps (implies threaded)
   bool sync_segmentation = false;  // --sync-segmentation: with --realtime, segment every frame taken
   int camera_preload_mb = -1;      // --camera-preload-mb (-1: RunOptions' default)
+  int simulate_detector_frames = 0;  // --simulate-camera-rate-masks N
   bool inline_mapping = false;
   bool inline_loop_closing = false;
   std::string segmenter;  // empty: dnn if the models are found, else none
@@ -139,6 +140,9 @@ void Run(RunArgs a) {
   options.threaded = a.threaded;
   options.realtime = a.realtime;
   options.async_segmentation = !a.sync_segmentation;
+  if (a.simulate_detector_frames > 0 && a.threaded)
+    throw InputError("--simulate-camera-rate-masks needs a sequential run (no --threaded or --realtime)");
+  options.simulated_detector_frames = a.simulate_detector_frames;
   if (a.camera_preload_mb >= 0) options.camera_preload_mb = static_cast<size_t>(a.camera_preload_mb);
   options.slam = SlamOptionsFromSettings(settings, a.seed);
   options.mapping_thread = a.threaded && !a.inline_mapping;
@@ -157,8 +161,9 @@ void Run(RunArgs a) {
   const std::string models_dir = a.models.empty() ? DefaultModelsDir() : a.models;
   std::string spec = a.segmenter;
   // At camera rate the detector runs at its own input size (Segmentation.CameraRateInputSize).
+  const bool camera_rate_masks = a.realtime || a.simulate_detector_frames > 0;
   const SegmenterSettings segmenter_settings =
-      a.realtime ? ForCameraRate(resolved.segmenter) : resolved.segmenter;
+      camera_rate_masks ? ForCameraRate(resolved.segmenter) : resolved.segmenter;
   std::unique_ptr<Segmenter> segmenter;
   if (spec.empty()) {
     try {
@@ -206,6 +211,12 @@ void Run(RunArgs a) {
                   options.slam.dynamic.keyframe_max_mask_age, s.keyframes_stale_masks,
                   options.slam.dynamic.keyframe_max_wait);
     }
+  }
+  if (options.simulated_detector_frames > 0 && s.async_segmentation) {
+    std::printf("simulated camera-rate masks (the detector takes %d frames): %zu frames segmented; masks used %.1f frames old (median, max %.0f); "
+                "%zu keyframes deferred for masks older than %d frames, %zu made with such masks\n",
+                options.simulated_detector_frames, s.frames_segmented, s.mask_age.median, s.mask_age.max,
+                s.keyframes_deferred, options.slam.dynamic.keyframe_max_mask_age, s.keyframes_stale_masks);
   }
   if (!s.segmenter.empty()) std::printf("segmentation (%s): median %.1f ms per frame\n", s.segmenter.c_str(), s.segmentation.median);
   std::printf("median ms per frame: extraction %.1f, tracking %.1f, total %.1f; local mapping %.1f per keyframe\n",
@@ -273,6 +284,9 @@ void AddRunCommand(CLI::App& app) {
                 "Camera rate: offer the frames at their timestamps as a live camera would (implies --threaded); a frame the pipeline has not taken when the next arrives is dropped, never queued; run.json reports the frames dropped and each frame's latency from arrival to pose");
   cmd->add_flag("--sync-segmentation", args->sync_segmentation,
                 "With --realtime: segment each frame taken before extracting it (the pipeline waits for the detector); default: asynchronous segmentation, each frame uses the newest masks carried to it by optical flow");
+  cmd->add_option("--simulate-camera-rate-masks", args->simulate_detector_frames,
+                  "Sequential run with the masks of --realtime's asynchronous segmentation, deterministically: the camera-rate detector takes N input frames per frame it segments, each frame uses the newest masks carried to it, and the camera-rate keyframe rules apply (reproduces the masks' timing, not the frame rate)")
+      ->check(CLI::Range(1, 1000));
   cmd->add_option("--camera-preload-mb", args->camera_preload_mb,
                   "With --realtime: decode the first frames, up to this many MiB, before the camera starts (a camera delivers decoded images); later frames are read and decoded on time by the camera thread (default 2048; 0: every frame on time)")
       ->check(CLI::NonNegativeNumber);

@@ -462,6 +462,56 @@ TEST(IntegrationRunner, FirstFrameCanBeLeftUntracked) {
   EXPECT_LT(s.reports.front().latency_ms, kSegmenterMs) << "the first frame tracked waited for the detector";
 }
 
+// A segmenter that records the frames it was asked to segment (no instances).
+class FrameListSegmenter : public Segmenter {
+ public:
+  std::vector<Instance> Segment(const SegmenterInput& in) override {
+    frames.push_back(in.index);
+    return {};
+  }
+  std::string name() const override { return "frame list"; }
+  std::vector<int64_t> frames;
+};
+
+// RunOptions::simulated_detector_frames: the camera-rate masks' timing in a sequential run. With a
+// detector that takes 3 frames, it segments frame 0 (the first frame waits for its own masks),
+// then frame 1 and every 3rd frame after (1, 4, 7, ...), each one's masks used from the frame 3
+// later; every frame is processed, and two runs give the same trajectory.
+TEST(IntegrationRunner, SimulatedCameraRateMasksAreDeterministic) {
+  const std::string seq = WriteStaticSequence("simulated_masks", 1, 60);
+  const RgbdDataset dataset = RgbdDataset::Open(seq, {});
+  const Settings settings = PresetForDataset(seq);
+  std::vector<std::string> trajectories;
+  for (int run = 0; run < 2; ++run) {
+    RunOptions options;
+    options.out_dir = TempDir("simulated_masks_run" + std::to_string(run));
+    options.simulated_detector_frames = 3;
+    options.slam = SlamOptionsFromSettings(settings, 42);
+    FrameListSegmenter segmenter;
+    const RunSummary s = detslam::Run(dataset, settings, options, nullptr, &segmenter);
+    std::vector<int64_t> expected = {0};
+    for (int64_t i = 1; i < 60; i += 3) expected.push_back(i);
+    EXPECT_EQ(segmenter.frames, expected);
+    EXPECT_TRUE(s.async_segmentation);
+    EXPECT_EQ(s.frames_segmented, expected.size());
+    ASSERT_EQ(s.reports.size(), 60u);
+    EXPECT_EQ(s.tracked, 60u);
+    for (const FrameReport& r : s.reports) {
+      // Frames 1-3 carry frame 0's masks; from frame 4 on, the detection started 3-5 frames before.
+      const int64_t source = r.index <= 3 ? 0 : 3 * ((r.index - 1) / 3) - 2;
+      EXPECT_EQ(r.mask_source, source) << "frame " << r.index;
+      EXPECT_EQ(r.mask_age, r.index - source) << "frame " << r.index;
+    }
+    const nlohmann::json j = nlohmann::json::parse(ReadFile((fs::path(options.out_dir) / "run.json").string()));
+    EXPECT_EQ(j["simulated_async_segmentation"]["detector_frames"], 3);
+    EXPECT_EQ(j["simulated_async_segmentation"]["frames_segmented"].get<size_t>(), expected.size());
+    EXPECT_EQ(j["dynamic_filter"]["geometric_region_frames"], options.camera_rate_region_frames);
+    trajectories.push_back(ReadFile((fs::path(options.out_dir) / "trajectory.txt").string()));
+  }
+  EXPECT_EQ(trajectories[0], trajectories[1]);
+  EXPECT_FALSE(trajectories[0].empty());
+}
+
 TEST(IntegrationSlamSynthetic, StaticPresetTracksEveryFrameWithinOneCentimetre) {
   const std::string seq = WriteStaticSequence("synth_static", 3, 240);
   const SlamRun run = RunAndEvaluate(seq, TempDir("synth_static_run"), 42);

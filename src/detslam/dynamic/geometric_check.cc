@@ -35,6 +35,11 @@ bool MoverCheckOptions::Check(std::string* error) const {
   if (!(depth_ratio >= 0)) message = "depth_ratio must be non-negative";
   if (min_cluster < 0) message = "min_cluster must be non-negative";
   if (!(carry_window_px > 0)) message = "carry_window_px must be positive";
+  if (region_frames < 0) message = "region_frames must be non-negative";
+  if (region_min_keypoints < 1) message = "region_min_keypoints must be positive";
+  if (!(region_growth_px >= 0)) message = "region_growth_px must be non-negative";
+  if (!(region_depth_ratio >= 0 && region_depth_ratio < 1))
+    message = "region_depth_ratio must be in [0, 1)";
   if (error != nullptr) *error = message;
   return message.empty();
 }

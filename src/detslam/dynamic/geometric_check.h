@@ -36,6 +36,14 @@ struct MoverCheckOptions {
   double depth_ratio = 0.1;         // same object: depths within this fraction
   int min_cluster = 3;              // flagged neighbours needed to confirm a mover
   double carry_window_px = 15.0;    // search window for last frame's movers (pixels, level 0)
+  // Mover regions (mover_check.h, MoverRegionsOf): each cluster of at least region_min_keypoints
+  // labelled keypoints becomes a region (their bounding box, and their depths' 10th to 90th
+  // percentile widened by region_depth_ratio) that labels the keypoints inside it at its depth in the next
+  // region_frames frames, its box grown by region_growth_px per frame. 0 frames: off.
+  int region_frames = 0;
+  int region_min_keypoints = 4;
+  double region_growth_px = 10.0;
+  double region_depth_ratio = 0.1;
 
   bool Check(std::string* error) const;
 };

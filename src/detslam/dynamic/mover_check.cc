@@ -16,7 +16,10 @@
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
+#include <map>
 
 #include "detslam/features/matcher.h"
 #include "detslam/map/projection_search.h"
@@ -34,7 +37,7 @@ bool SameDepth(float a, float b, double ratio) {
 int LabelMovers(const PinholeCamera& camera, const ScaleInfo& scale,
                 const MoverCheckOptions& options, const Frame& frame,
                 const std::vector<std::optional<Eigen::Vector3d>>& points, const Frame* last_frame,
-                std::vector<KeypointLabel>* labels) {
+                std::vector<KeypointLabel>* labels, std::vector<size_t>* confirmed) {
   const FrameFeatures& f = *frame.features;
   const size_t n = f.size();
   const Rigid3d& pose = *frame.cam_from_world;
@@ -51,20 +54,25 @@ int LabelMovers(const PinholeCamera& camera, const ScaleInfo& scale,
   std::vector<KeypointLabel> candidate = *labels;
   const GeometricCheckResult stats = FlagGeometricOutliers(residual, options.threshold, &candidate);
 
-  // 2. Confirm candidates by flagged neighbours at the same depth.
+  // 2. Confirm candidates by flagged neighbours at the same depth (candidates of this call only:
+  //    keypoints labelled before it, e.g. in a mover region, are not evidence).
   const double radius = options.radius_px;
+  const auto flagged = [&](size_t i) {
+    return candidate[i] == KeypointLabel::kGeometric && (*labels)[i] == KeypointLabel::kStatic;
+  };
   std::vector<size_t> seeds;
   for (size_t i = 0; i < n; ++i) {
-    if (candidate[i] != KeypointLabel::kGeometric) continue;
+    if (!flagged(i)) continue;
     int neighbours = 0;
     for (size_t j : f.grid->FeaturesInArea(f.undist[i].x(), f.undist[i].y(), radius)) {
-      if (j != i && candidate[j] == KeypointLabel::kGeometric &&
+      if (j != i && flagged(j) &&
           SameDepth(f.depth[i], f.depth[j], options.depth_ratio)) {
         ++neighbours;
       }
     }
     if (neighbours >= options.min_cluster) seeds.push_back(i);
   }
+  if (confirmed != nullptr) *confirmed = seeds;
 
   // 3. Keypoints matching the last frame's movers (searched around their last 3-D position) that
   //    moved: a residual against that position above the threshold (a keypoint that stayed put
@@ -127,6 +135,82 @@ int LabelMovers(const PinholeCamera& camera, const ScaleInfo& scale,
       frame.index, stats.samples, stats.median, stats.threshold, stats.flagged, seeds.size(),
       spread, carried.size());
 
+  return labelled;
+}
+
+std::vector<MoverRegion> MoverRegionsOf(const MoverCheckOptions& options, const Frame& frame,
+                                        const std::vector<KeypointLabel>& labels) {
+  const FrameFeatures& f = *frame.features;
+  const size_t n = f.size();
+  // Union-find over the labelled keypoints with depth.
+  std::vector<size_t> parent(n);
+  for (size_t i = 0; i < n; ++i) parent[i] = i;
+  const auto root = [&](size_t i) {
+    while (parent[i] != i) i = parent[i] = parent[parent[i]];
+    return i;
+  };
+  const auto mover = [&](size_t i) {
+    return labels[i] == KeypointLabel::kGeometric && f.depth[i] > 0;
+  };
+  for (size_t i = 0; i < n; ++i) {
+    if (!mover(i)) continue;
+    for (size_t j : f.grid->FeaturesInArea(f.undist[i].x(), f.undist[i].y(), options.radius_px)) {
+      if (j != i && mover(j) && SameDepth(f.depth[i], f.depth[j], options.depth_ratio))
+        parent[root(j)] = root(i);
+    }
+  }
+  std::map<size_t, std::vector<size_t>> clusters;
+  for (size_t i = 0; i < n; ++i) {
+    if (mover(i)) clusters[root(i)].push_back(i);
+  }
+  std::vector<MoverRegion> regions;
+  for (const auto& [r, members] : clusters) {
+    if (static_cast<int>(members.size()) < options.region_min_keypoints) continue;
+    MoverRegion region;
+    region.frame = frame.index;
+    region.min_u = region.min_v = std::numeric_limits<double>::infinity();
+    region.max_u = region.max_v = -std::numeric_limits<double>::infinity();
+    std::vector<double> depths;
+    for (size_t i : members) {
+      region.min_u = std::min(region.min_u, f.undist[i].x());
+      region.max_u = std::max(region.max_u, f.undist[i].x());
+      region.min_v = std::min(region.min_v, f.undist[i].y());
+      region.max_v = std::max(region.max_v, f.undist[i].y());
+      depths.push_back(f.depth[i]);
+    }
+    // The cluster's depths without their tails (a chain of neighbours at the same depth may
+    // stretch along a surface), widened by region_depth_ratio.
+    std::sort(depths.begin(), depths.end());
+    const auto quantile = [&](double q) {
+      return depths[static_cast<size_t>(q * static_cast<double>(depths.size() - 1) + 0.5)];
+    };
+    region.min_depth = quantile(0.1) * (1.0 - options.region_depth_ratio);
+    region.max_depth = quantile(0.9) * (1.0 + options.region_depth_ratio);
+    regions.push_back(region);
+  }
+  return regions;
+}
+
+int LabelInMoverRegions(const std::vector<MoverRegion>& regions, const MoverCheckOptions& options,
+                        const Frame& frame, std::vector<KeypointLabel>* labels) {
+  const FrameFeatures& f = *frame.features;
+  int labelled = 0;
+  for (const MoverRegion& r : regions) {
+    const int64_t since = frame.index - r.frame;
+    if (since < 1 || since > options.region_frames) continue;
+    const double grow = options.radius_px + options.region_growth_px * static_cast<double>(since);
+    for (size_t i = 0; i < f.size(); ++i) {
+      if ((*labels)[i] != KeypointLabel::kStatic || f.depth[i] < r.min_depth ||
+          f.depth[i] > r.max_depth)
+        continue;
+      const Eigen::Vector2d& p = f.undist[i];
+      if (p.x() < r.min_u - grow || p.x() > r.max_u + grow || p.y() < r.min_v - grow ||
+          p.y() > r.max_v + grow)
+        continue;
+      (*labels)[i] = KeypointLabel::kGeometric;
+      ++labelled;
+    }
+  }
   return labelled;
 }
 

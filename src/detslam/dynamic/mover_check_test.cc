@@ -5,6 +5,8 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
+
 namespace detslam {
 namespace {
 
@@ -54,8 +56,10 @@ TEST(LabelMovers, LabelsAConfirmedClusterAndItsUnmatchedNeighbourNotAnIsolatedOu
   const PinholeCamera camera;
   Scene s = MakeScene(camera);
   MoverCheckOptions options;
+  std::vector<size_t> confirmed;
   const int labelled = LabelMovers(camera, ScaleInfo::Geometric(1.2, 8), options, s.frame, s.points,
-                                   nullptr, &s.frame.labels);
+                                   nullptr, &s.frame.labels, &confirmed);
+  EXPECT_EQ(confirmed, s.cluster);  // the seeds: not the unmatched neighbour
   for (size_t i : s.cluster) EXPECT_EQ(s.frame.labels[i], KeypointLabel::kGeometric) << i;
   EXPECT_EQ(s.frame.labels[s.unmatched], KeypointLabel::kGeometric);
   EXPECT_EQ(s.frame.labels[s.isolated], KeypointLabel::kStatic);
@@ -78,6 +82,102 @@ TEST(LabelMovers, NeedsEnoughFlaggedNeighboursAndKeepsOtherLabels) {
   EXPECT_EQ(s.frame.labels[s.cluster[0]], KeypointLabel::kDynamicMask);
   for (size_t k = 1; k < s.cluster.size(); ++k)
     EXPECT_EQ(s.frame.labels[s.cluster[k]], KeypointLabel::kStatic);
+}
+
+
+TEST(LabelMovers, KeypointsLabelledBeforeAreNoEvidence) {
+  // The cluster already labelled (e.g. by a mover region): it confirms nothing, so its unmatched
+  // neighbour stays static (a region must not spread through the check).
+  const PinholeCamera camera;
+  Scene s = MakeScene(camera);
+  for (size_t i : s.cluster) s.frame.labels[i] = KeypointLabel::kGeometric;
+  EXPECT_EQ(LabelMovers(camera, ScaleInfo::Geometric(1.2, 8), MoverCheckOptions(), s.frame,
+                        s.points, nullptr, &s.frame.labels),
+            0);
+  EXPECT_EQ(s.frame.labels[s.unmatched], KeypointLabel::kStatic);
+}
+
+// A frame with the given keypoints (x, y, depth), every label static.
+Frame FrameOf(const PinholeCamera& camera, int64_t index,
+              const std::vector<std::array<float, 3>>& points) {
+  std::vector<cv::KeyPoint> kps;
+  std::vector<float> depth;
+  for (const auto& p : points) {
+    kps.emplace_back(p[0], p[1], 31.0f, 0.0f, 1.0f, 0);
+    depth.push_back(p[2]);
+  }
+  Frame frame;
+  frame.index = index;
+  frame.features = BuildFrameFeatures(
+      camera, kps, cv::Mat::zeros(static_cast<int>(kps.size()), 32, CV_8UC1), depth);
+  frame.landmarks.assign(kps.size(), kNoLandmark);
+  frame.labels.assign(kps.size(), KeypointLabel::kStatic);
+  return frame;
+}
+
+TEST(MoverRegions, OneRegionPerClusterAtOneDepthWithEnoughKeypoints) {
+  const PinholeCamera camera;  // no distortion: undistorted = detected pixels
+  std::vector<std::array<float, 3>> pts;
+  for (int k = 0; k < 12; ++k) pts.push_back({100.0f + 10 * k, 100.0f + (k % 2) * 8, 1.5f});  // A
+  for (int k = 0; k < 12; ++k) pts.push_back({100.0f + 10 * k, 104.0f, 3.0f});  // B: behind A
+  for (int k = 0; k < 9; ++k) pts.push_back({400.0f + 10 * k, 300.0f, 2.0f});  // C: too few
+  pts.push_back({600.0f, 50.0f, 1.0f});  // not labelled
+  Frame frame = FrameOf(camera, 4, pts);
+  std::vector<KeypointLabel> labels(pts.size(), KeypointLabel::kGeometric);
+  labels.back() = KeypointLabel::kStatic;
+  MoverCheckOptions options;
+  options.region_min_keypoints = 10;
+  const std::vector<MoverRegion> regions = MoverRegionsOf(options, frame, labels);
+  ASSERT_EQ(regions.size(), 2u);
+  for (const MoverRegion& r : regions) {
+    EXPECT_EQ(r.frame, 4);
+    EXPECT_NEAR(r.min_u, 100.0, 1e-6);
+    EXPECT_NEAR(r.max_u, 210.0, 1e-6);
+    // Each cluster at one depth, widened by 10 %.
+    EXPECT_NEAR(r.max_depth / r.min_depth, 1.1 / 0.9, 1e-9);
+  }
+  EXPECT_NEAR(regions[0].min_depth + regions[1].min_depth, 0.9 * 4.5, 1e-6);
+  EXPECT_NEAR(std::min(regions[0].min_v, regions[1].min_v), 100.0, 1e-6);
+  EXPECT_NEAR(std::max(regions[0].max_v, regions[1].max_v), 108.0, 1e-6);
+  options.region_min_keypoints = 9;  // now C too
+  EXPECT_EQ(MoverRegionsOf(options, frame, labels).size(), 3u);
+}
+
+TEST(MoverRegions, LabelInsideTheGrownBoxAtItsDepthForRegionFramesOnly) {
+  const PinholeCamera camera;
+  MoverRegion region;
+  region.frame = 5;
+  region.min_u = 100, region.max_u = 140, region.min_v = 100, region.max_v = 120;
+  region.min_depth = 1.26, region.max_depth = 1.76;
+  MoverCheckOptions options;
+  options.radius_px = 30;
+  options.region_growth_px = 10;
+  options.region_frames = 4;
+  // Two frames later the box is grown by 30 + 2 * 10 = 50 px: u in [50, 190], v in [50, 170].
+  const std::vector<std::array<float, 3>> pts = {
+      {60, 60, 1.5f},    // 0: inside, at its depth
+      {185, 165, 1.3f},  // 1: inside, near its front
+      {120, 110, 3.0f},  // 2: inside, behind it
+      {200, 110, 1.5f},  // 3: beside the grown box
+      {120, 110, 1.5f},  // 4: inside but already a mask label
+      {120, 110, 1.1f},  // 5: inside, in front of it
+  };
+  Frame frame = FrameOf(camera, 7, pts);
+  frame.labels[4] = KeypointLabel::kDynamicMask;
+  EXPECT_EQ(LabelInMoverRegions({region}, options, frame, &frame.labels), 2);
+  EXPECT_EQ(frame.labels[0], KeypointLabel::kGeometric);
+  EXPECT_EQ(frame.labels[1], KeypointLabel::kGeometric);
+  EXPECT_EQ(frame.labels[2], KeypointLabel::kStatic);
+  EXPECT_EQ(frame.labels[3], KeypointLabel::kStatic);
+  EXPECT_EQ(frame.labels[4], KeypointLabel::kDynamicMask);
+  EXPECT_EQ(frame.labels[5], KeypointLabel::kStatic);
+  // In its own frame and after region_frames it labels nothing.
+  for (int64_t index : {5, 10}) {
+    Frame other = FrameOf(camera, index, pts);
+    EXPECT_EQ(LabelInMoverRegions({region}, options, other, &other.labels), 0) << index;
+  }
+  Frame last = FrameOf(camera, 9, {{60, 60, 1.5f}});  // 4 frames later: grown by 70 px
+  EXPECT_EQ(LabelInMoverRegions({region}, options, last, &last.labels), 1);
 }
 
 }  // namespace

@@ -130,6 +130,8 @@ class Map {
   int MapOf(KeyFrameId kf) const { return keyframe(kf).map_id; }
   // Keyframes of one map, ascending.
   std::vector<KeyFrameId> KeyFramesOfMap(int map_id) const;
+  // Their number (ORB-SLAM3's KeyFramesInMap), without building the list.
+  size_t NumKeyFramesOfMap(int map_id) const;
   // Moves map `from` into map `into`: every keyframe and landmark of `from` is transformed by
   // `into_from_from` (world_into_from_world_from) and relabelled, its spanning tree is re-rooted
   // at `seam` (a keyframe of `from`) and hung below `into_seam` (a keyframe of `into`). Returns

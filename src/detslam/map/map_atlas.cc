@@ -1,4 +1,6 @@
 // The atlas side of the Map: map roots, keyframes by map, merging one map into another.
+#include <algorithm>
+
 #include "detslam/core/check.h"
 #include "detslam/map/map.h"
 
@@ -17,6 +19,11 @@ std::vector<KeyFrameId> Map::KeyFramesOfMap(int map_id) const {
     if (kf.map_id == map_id) out.push_back(id);
   }
   return out;
+}
+
+size_t Map::NumKeyFramesOfMap(int map_id) const {
+  return static_cast<size_t>(std::count_if(keyframes_.begin(), keyframes_.end(),
+                                           [map_id](const auto& k) { return k.second.map_id == map_id; }));
 }
 
 std::map<KeyFrameId, Rigid3d> Map::MergeMapInto(int from, int into, const Rigid3d& into_from_from,

@@ -58,6 +58,9 @@ TEST(MapAtlas, EachMapHasARootThatIsNeverCulledNorParented) {
     for (const auto& [other, w] : map.keyframe(k).covisibility) EXPECT_EQ(map.MapOf(other), 1);
   }
   EXPECT_EQ(map.KeyFramesOfMap(1), b);
+  EXPECT_EQ(map.NumKeyFramesOfMap(1), b.size());
+  EXPECT_EQ(map.NumKeyFramesOfMap(0) + b.size(), map.NumKeyFrames());
+  EXPECT_EQ(map.NumKeyFramesOfMap(7), 0u);
 }
 
 TEST(MapAtlas, MergeMovesTheMapRigidlyAndReRootsItsTreeAtTheSeam) {

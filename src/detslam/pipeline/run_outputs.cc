@@ -251,6 +251,17 @@ void WriteRunOutputs(const RgbdSource& dataset, const Settings& settings, const 
       j["realtime"]["keyframes_stale_masks"] = summary.keyframes_stale_masks;
     }
   }
+  if (!options.realtime && summary.async_segmentation) {
+    j["simulated_async_segmentation"] = {
+        {"detector_frames", options.simulated_detector_frames},
+        {"frames_segmented", summary.frames_segmented},
+        {"mask_age_frames",
+         {{"median", summary.mask_age.median},
+          {"mean", summary.mask_age.mean},
+          {"max", summary.mask_age.max}}},
+        {"keyframes_deferred", summary.keyframes_deferred},
+        {"keyframes_stale_masks", summary.keyframes_stale_masks}};
+  }
   j["segmenter"] = summary.segmenter.empty() ? "none" : summary.segmenter;
   const DetSlamOptions& dyn = options.slam.dynamic;
   j["dynamic_filter"] = {{"classes", dyn.filter.dynamic_classes},
@@ -261,6 +272,9 @@ void WriteRunOutputs(const RgbdSource& dataset, const Settings& settings, const 
                          {"memory_frames", dyn.memory_frames},
                          {"depth_track_frames", dyn.depth_track_frames},
                          {"geometric_check", dyn.geometric.enabled},
+                         {"geometric_region_frames", summary.async_segmentation
+                                                         ? options.camera_rate_region_frames
+                                                         : dyn.geometric.region_frames},
                          {"segment_every", dyn.segment_every},
                          {"keyframe_max_mask_age", dyn.keyframe_max_mask_age},
                          {"keyframe_max_wait", dyn.keyframe_max_wait},

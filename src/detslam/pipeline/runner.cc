@@ -397,6 +397,67 @@ RunSummary Finish(RunRecorder& recorder, const RgbdSource& dataset, const Settin
   return summary;
 }
 
+// The SLAM options of a run whose masks come asynchronously (RunOptions::
+// camera_rate_region_frames).
+SlamOptions CameraRateMasks(const RunOptions& options) {
+  SlamOptions slam = options.slam;
+  slam.dynamic.geometric.region_frames = options.camera_rate_region_frames;
+  return slam;
+}
+
+// Gives a frame the instances a MaskCarrier carried to it (asynchronous segmentation).
+void UseCarried(CarriedInstances c, LoadedFrame* f) {
+  f->instances = std::move(c.instances);
+  f->segmented = true;
+  f->segmentation_ms = c.carry_ms;
+  f->mask_source = c.source;
+  f->mask_age = c.age;
+}
+
+// Sequential mode, RunOptions::simulated_detector_frames: the camera-rate mode's asynchronous
+// segmentation with a detector that takes a fixed number of input frames per frame it segments,
+// so that its mask timing is deterministic. The detector starts on the newest frame whenever it is
+// free; its result is published before the frame `frames` later is tracked; the first frame waits
+// for its own masks.
+class SimulatedAsyncSegmentation {
+ public:
+  SimulatedAsyncSegmentation(int frames, const MaskPropagationOptions& propagation)
+      : frames_(frames), carrier_(propagation) {}
+
+  // Frames in input order, readable ones only.
+  void Carry(const RgbdSource& dataset, SlamSystem* slam, LoadedFrame* f) {
+    if (pending_ && f->index >= pending_->ready) Publish();
+    if (!pending_) {
+      const FrameInstances d = slam->DetectFrame(SegmentationInput(dataset, *f));
+      detection_ms_.push_back(d.segmentation_ms);
+      const bool first = carrier_.published() == 0;
+      pending_ = Pending{f->index, f->index + (first ? 0 : frames_), f->images.gray,
+                         d.instances};
+      if (first) Publish();
+    }
+    if (std::optional<CarriedInstances> c = carrier_.Carry(f->index, f->images.gray))
+      UseCarried(std::move(*c), f);
+  }
+
+  const std::vector<double>& detection_ms() const { return detection_ms_; }
+
+ private:
+  struct Pending {
+    int64_t index, ready;
+    cv::Mat gray;
+    std::vector<Instance> instances;
+  };
+  void Publish() {
+    carrier_.Publish(pending_->index, pending_->gray, std::move(pending_->instances));
+    pending_.reset();
+  }
+
+  int frames_;
+  MaskCarrier carrier_;
+  std::optional<Pending> pending_;  // the detection in progress
+  std::vector<double> detection_ms_;
+};
+
 Frame Extract(const SlamSystem& slam, const RgbdSource& dataset, const LoadedFrame& f,
               FrameReport* report) {
   report->segmentation_ms = f.segmentation_ms;
@@ -414,19 +475,25 @@ RunSummary RunSequential(const RgbdSource& dataset, const Settings& settings,
                          Segmenter* segmenter) {
   const auto start = std::chrono::steady_clock::now();
   CheckOutputs(options);
-  SlamSystem slam(settings.camera, options.slam, segmenter);
+  const bool simulate = segmenter != nullptr && options.simulated_detector_frames > 0;
+  SlamSystem slam(settings.camera, simulate ? CameraRateMasks(options) : options.slam, segmenter);
   const size_t n = FrameCount(dataset, options);
   RunRecorder recorder(n, progress, options);
   recorder.LoadMap(options, &slam);
   const StopWatcher watcher(options, &slam);
   RunObserver* observer = options.observer;
   if (observer) observer->OnStart(n, /*pausable=*/true);
+  std::optional<SimulatedAsyncSegmentation> simulated;
+  if (simulate)
+    simulated.emplace(options.simulated_detector_frames, options.slam.dynamic.propagation);
   for (size_t i = 0; i < n && !StopRequested(options); ++i) {
     if (observer) {
       observer->WaitBeforeFrame(static_cast<int64_t>(i), slam);
       if (StopRequested(options)) break;
     }
-    const LoadedFrame loaded = LoadAndSegment(dataset, settings, i, &slam);
+    LoadedFrame loaded = simulated ? LoadFrame(dataset, settings, i)
+                                   : LoadAndSegment(dataset, settings, i, &slam);
+    if (simulated && loaded.unreadable.empty()) simulated->Carry(dataset, &slam, &loaded);
     if (!loaded.unreadable.empty()) {
       const FrameReport report = SkippedReport(dataset, loaded);
       recorder.AddSkipped(report);
@@ -444,6 +511,7 @@ RunSummary RunSequential(const RgbdSource& dataset, const Settings& settings,
     Observe(observer, slam, report, &loaded.images.bgr,
             loaded.segmented ? &loaded.instances : nullptr, &tracked);
   }
+  if (simulated) recorder.SetAsyncSegmentation(simulated->detection_ms());
   return Finish(recorder, dataset, settings, options, slam, start, segmenter);
 }
 
@@ -453,7 +521,9 @@ RunSummary RunThreaded(const RgbdSource& dataset, const Settings& settings,
   const auto start = std::chrono::steady_clock::now();
   CheckOutputs(options);
   const OpenCvThreads cv_threads(options.realtime ? options.camera_rate_opencv_threads : 0);
-  SlamOptions slam_options = options.slam;
+  // Asynchronous segmentation: the newest frame for the segmentation thread, and its results.
+  const bool async = options.realtime && options.async_segmentation && segmenter != nullptr;
+  SlamOptions slam_options = async ? CameraRateMasks(options) : options.slam;
   slam_options.global_ba_thread = options.mapping_thread;  // nothing waits for it then
   slam_options.loop_thread = options.mapping_thread && options.loop_thread;
   SlamSystem slam(settings.camera, slam_options, segmenter);
@@ -481,8 +551,6 @@ RunSummary RunThreaded(const RgbdSource& dataset, const Settings& settings,
   // reached in practice, and a full queue only makes local mapping wait, never a deadlock: local
   // mapping pushes outside its turn, see SlamSystem::loop_thread).
   BoundedQueue<KeyFrameId> to_close(1024);
-  // Asynchronous segmentation: the newest frame for the segmentation thread, and its results.
-  const bool async = options.realtime && options.async_segmentation && segmenter != nullptr;
   BoundedQueue<LoadedFrame> to_segment(1);
   MaskCarrier carrier(options.slam.dynamic.propagation);
   std::vector<double> detection_ms;  // the segmentation thread's until Join
@@ -579,11 +647,7 @@ RunSummary RunThreaded(const RgbdSource& dataset, const Settings& settings,
     }
     std::optional<CarriedInstances> c = carrier.Carry(f->index, f->images.gray);
     if (!c) return true;  // the segmentation thread stopped before publishing anything
-    f->instances = std::move(c->instances);
-    f->segmented = true;
-    f->segmentation_ms = c->carry_ms;
-    f->mask_source = c->source;
-    f->mask_age = c->age;
+    UseCarried(std::move(*c), f);
     return true;
   };
   BoundedQueue<LoadedFrame>& extraction_input = async ? camera : loaded;

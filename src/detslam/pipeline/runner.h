@@ -47,6 +47,20 @@ struct RunOptions {
   // and tracking starts with the next frame, its masks carried from the first. Chosen on the
   // tuning seeds (README, Options).
   bool first_frame_waits_for_masks = true;
+  // Sequential mode with a segmenter: the asynchronous segmentation above, simulated so that it is
+  // deterministic: the detector takes this many input frames for each frame it segments (it starts
+  // on the newest frame whenever it is free, and its masks are published before the frame that
+  // many later is tracked; the first frame waits for its own), each frame uses the newest masks
+  // carried to it, with their age, and the camera-rate keyframe rules apply. Frames are not
+  // dropped and nothing runs at camera rate: it reproduces the masks' timing, not the frame
+  // rate. 0: off (every frame segmented before its extraction). For choosing the camera-rate
+  // settings by runs that repeat; a live run's detector time varies (docs/STATUS.md).
+  int simulated_detector_frames = 0;
+  // Asynchronous segmentation (camera rate or simulated_detector_frames): the geometric check's
+  // mover regions are carried this many frames (MoverCheckOptions::region_frames, replacing
+  // slam.dynamic.geometric's), because a person entering the view is in the masks only several
+  // frames later. Chosen on the walking presets' tuning seeds 1-3 (README, Options).
+  int camera_rate_region_frames = 10;
   // Camera-rate mode: the first frames, up to this many MiB of decoded images, are read and
   // decoded before the camera starts (a camera delivers decoded images; decoding PNG files would
   // take CPU time a live camera does not); later frames are read on time by the camera thread.

@@ -13,6 +13,7 @@
 #include "detslam/core/id_stamps.h"
 #include "detslam/core/rng.h"
 #include "detslam/dynamic/geometric_check.h"
+#include "detslam/dynamic/mover_check.h"
 #include "detslam/map/map.h"
 #include "detslam/optim/pose_optimizer.h"
 
@@ -221,6 +222,7 @@ class Tracker {
   IdStamps local_landmark_set_;  // local_landmarks_ as a set (rebuilt each frame)
   IdStamps matched_set_;         // the current frame's matched landmarks (TrackLocalMap)
   FrameScratch scratch_;
+  std::vector<MoverRegion> mover_regions_;  // the geometric check's, of the last frames
 };
 
 }  // namespace detslam

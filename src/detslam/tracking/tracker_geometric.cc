@@ -1,5 +1,9 @@
 // Tracker: runs the Det-SLAM stage's geometric check (dynamic/mover_check.h) on a tracked frame
 // and drops the map associations of the movers it labels.
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+
 #include "detslam/dynamic/mover_check.h"
 #include "detslam/tracking/tracker.h"
 
@@ -17,8 +21,34 @@ int Tracker::ApplyGeometricCheck(const Map& map, Frame* frame, int* inliers) {
       points[i] = scratch_.dropped_position[i];
     }
   }
-  const int labelled = LabelMovers(camera_, map.scale(), movers_, *frame, points,
-                                   last_frame_ ? &*last_frame_ : nullptr, &frame->labels);
+  // Keypoints in the regions of the last frames' movers first, so that they stay out of the
+  // robust statistics too; new regions only from this frame's confirmed movers (a region never
+  // renews itself, nor grows over the static scene by the labels spread around movers).
+  int labelled = 0;
+  if (movers_.region_frames > 0) {
+    mover_regions_.erase(
+        std::remove_if(mover_regions_.begin(), mover_regions_.end(),
+                       [&](const MoverRegion& r) {
+                         return frame->index - r.frame > movers_.region_frames ||
+                                frame->index < r.frame;
+                       }),
+        mover_regions_.end());
+    labelled += LabelInMoverRegions(mover_regions_, movers_, *frame, &frame->labels);
+    spdlog::debug("frame {}: {} keypoints in {} mover regions", frame->index, labelled,
+                  mover_regions_.size());
+  }
+  std::vector<size_t> confirmed;
+  labelled += LabelMovers(camera_, map.scale(), movers_, *frame, points,
+                          last_frame_ ? &*last_frame_ : nullptr, &frame->labels, &confirmed);
+  if (movers_.region_frames > 0) {
+    std::vector<KeypointLabel> found(n, KeypointLabel::kStatic);
+    for (size_t i : confirmed) found[i] = KeypointLabel::kGeometric;
+    for (const MoverRegion& r : MoverRegionsOf(movers_, *frame, found)) {
+      spdlog::debug("frame {}: mover region u {:.0f}-{:.0f} v {:.0f}-{:.0f} depth {:.2f}-{:.2f}",
+                    frame->index, r.min_u, r.max_u, r.min_v, r.max_v, r.min_depth, r.max_depth);
+      mover_regions_.push_back(r);
+    }
+  }
 
   // 5. Movers must not hold map associations; re-optimise if an inlier was one.
   bool dropped_inlier = false;

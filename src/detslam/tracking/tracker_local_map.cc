@@ -237,11 +237,8 @@ bool Tracker::NeedNewKeyFrame(const Map& map, const Frame& frame, int inliers,
   // whose points have 2 or more observations; none had, so the ratio rule never asked for a
   // keyframe and the new map went seconds with one.
   int num_kfs = static_cast<int>(map.NumKeyFrames());
-  if (map.map_roots().size() > 1 && map.HasKeyFrame(reference_kf_)) {
-    const int active = map.MapOf(reference_kf_);
-    num_kfs = static_cast<int>(std::count_if(map.keyframes().begin(), map.keyframes().end(),
-                                             [active](const auto& k) { return k.second.map_id == active; }));
-  }
+  if (map.map_roots().size() > 1 && map.HasKeyFrame(reference_kf_))
+    num_kfs = static_cast<int>(map.NumKeyFramesOfMap(map.MapOf(reference_kf_)));
   const int max_frames = options_.max_frames_between_keyframes;
   if (frame.index < last_reloc_frame_ + max_frames && num_kfs > max_frames) return false;
   // ORB-SLAM counts an RGB-D observation twice; in keyframes its 2 (3) observations are 1 (2).
