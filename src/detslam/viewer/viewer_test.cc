@@ -102,6 +102,7 @@ class FakeContent : public ViewerContent {
  public:
   std::string Title() const override { return "fake \"run\""; }
   uint64_t WaitForUpdate(uint64_t seen, std::chrono::milliseconds timeout) override {
+    ++waits;
     std::unique_lock<std::mutex> lock(mutex_);
     changed_.wait_for(lock, timeout, [&] { return update_ > seen; });
     return update_;
@@ -139,6 +140,7 @@ class FakeContent : public ViewerContent {
     return actions_;
   }
   std::atomic<int> clients{0};
+  std::atomic<int> waits{0};  // WaitForUpdate calls (a stream calls it after its first state)
 
  private:
   mutable std::mutex mutex_;  // the server calls from its threads
@@ -248,9 +250,13 @@ TEST(ViewerServer, TheUpdateStreamSendsTheNewestFrameAndCountsItsClients) {
   // The client counts once the server has taken the connection (on a loaded machine that can take
   // longer than a moment; the stream is read for 3 s).
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::milliseconds(2500);
-  while (content.clients.load() == 0 && std::chrono::steady_clock::now() < deadline)
+  // ... and the stream has sent its first state once it waits for an update (under
+  // ThreadSanitizer on a loaded machine the frames below once came before it: CI, 2026-12-06).
+  while ((content.clients.load() == 0 || content.waits.load() == 0) &&
+         std::chrono::steady_clock::now() < deadline)
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
   EXPECT_EQ(content.clients.load(), 1);
+  EXPECT_GT(content.waits.load(), 0);
   for (int i = 2; i <= 50; ++i) content.SetFrame(i);  // faster than a page reads them
   const std::string text = stream.get();
   EXPECT_EQ(Status(text), 200);
