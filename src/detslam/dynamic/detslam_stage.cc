@@ -84,6 +84,11 @@ FrameInstances DetSlamStage::Detect(const SegmenterInput& input) {
   return Timed([&] { return memory_.Update(Used(segmenter_->Segment(input)), input.depth_m, elapsed); });
 }
 
+DynamicRegions DetSlamStage::Regions(const std::vector<Instance>& instances,
+                                     const cv::Mat& depth_m, const cv::Size& image_size) const {
+  return DynamicRegions::Build(instances, depth_m, image_size, options_.filter);
+}
+
 LabelledKeypoints DetSlamStage::Extract(const OrbExtractor& extractor, const cv::Mat& gray,
                                         const cv::Mat& depth_m, const cv::Mat& ignore_mask,
                                         const std::vector<Instance>* instances) const {

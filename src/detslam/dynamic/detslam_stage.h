@@ -41,6 +41,13 @@ struct DetSlamOptions {
   // fast, the inliers fell from 86 to 34 over the 5 frames of a deferral and tracking failed.
   int keyframe_defer_min_inliers = 100;
   int keyframe_max_wait = 6;  // 0.2 s at 30 Hz
+  // Keyframes cleaned by their own masks (asynchronous segmentation only): when the detector's
+  // result for a frame that became a keyframe (with carried masks) comes, the keyframe's keypoints
+  // are labelled by it; the points the keyframe made on objects are erased, older points lose its
+  // view. Chosen on walking tuning seeds 1-6 (--simulate-camera-rate-masks 5, and live runs): it
+  // removes the runs where the tracker followed a person the carried masks missed, at a slightly
+  // higher median error (README).
+  bool keyframe_clean_own_masks = true;
   MaskPropagationOptions propagation;  // how masks move between segmented frames
   MoverCheckOptions geometric;         // geometric check for movers the segmenter missed (tracker)
 
@@ -86,6 +93,11 @@ class DetSlamStage {
   LabelledKeypoints Extract(const OrbExtractor& extractor, const cv::Mat& gray,
                             const cv::Mat& depth_m, const cv::Mat& ignore_mask,
                             const std::vector<Instance>* instances) const;
+  // The regions Extract would label a frame's keypoints with (mask step and depth step), for
+  // labelling keypoints extracted earlier (keyframes cleaned by their own masks). `depth_m`: the
+  // frame's depth (CV_32FC1 metres, 0 = missing) of `image_size`.
+  DynamicRegions Regions(const std::vector<Instance>& instances, const cv::Mat& depth_m,
+                         const cv::Size& image_size) const;
 
  private:
   // The instances the filter acts on (DynamicFilterOptions::Uses): the others (static classes,

@@ -249,6 +249,8 @@ void WriteRunOutputs(const RgbdSource& dataset, const Settings& settings, const 
                                           {"max", summary.mask_age.max}};
       j["realtime"]["keyframes_deferred"] = summary.keyframes_deferred;
       j["realtime"]["keyframes_stale_masks"] = summary.keyframes_stale_masks;
+      j["realtime"]["keyframes_cleaned"] = summary.keyframes_cleaned;
+      j["realtime"]["keypoints_cleaned"] = summary.keypoints_cleaned;
     }
   }
   if (!options.realtime && summary.async_segmentation) {
@@ -260,7 +262,9 @@ void WriteRunOutputs(const RgbdSource& dataset, const Settings& settings, const 
           {"mean", summary.mask_age.mean},
           {"max", summary.mask_age.max}}},
         {"keyframes_deferred", summary.keyframes_deferred},
-        {"keyframes_stale_masks", summary.keyframes_stale_masks}};
+        {"keyframes_stale_masks", summary.keyframes_stale_masks},
+        {"keyframes_cleaned", summary.keyframes_cleaned},
+        {"keypoints_cleaned", summary.keypoints_cleaned}};
   }
   j["segmenter"] = summary.segmenter.empty() ? "none" : summary.segmenter;
   const DetSlamOptions& dyn = options.slam.dynamic;
@@ -278,7 +282,8 @@ void WriteRunOutputs(const RgbdSource& dataset, const Settings& settings, const 
                          {"segment_every", dyn.segment_every},
                          {"keyframe_max_mask_age", dyn.keyframe_max_mask_age},
                          {"keyframe_max_wait", dyn.keyframe_max_wait},
-                         {"keyframe_defer_min_inliers", dyn.keyframe_defer_min_inliers}};
+                         {"keyframe_defer_min_inliers", dyn.keyframe_defer_min_inliers},
+                         {"keyframe_clean_own_masks", dyn.keyframe_clean_own_masks}};
   j["timings"] = {{"segmentation", StatsJson(summary.segmentation)},
                   {"extraction", StatsJson(summary.extraction)},
                   {"tracking", StatsJson(summary.tracking)},
@@ -319,6 +324,7 @@ void WriteRunOutputs(const RgbdSource& dataset, const Settings& settings, const 
     }
     if (r.keyframe_deferred) per_frame.back()["keyframe_deferred"] = true;
     if (r.keyframe_stale_masks) per_frame.back()["keyframe_stale_masks"] = true;
+    if (r.keyframe_cleaned >= 0) per_frame.back()["keyframe_cleaned_keypoints"] = r.keyframe_cleaned;
   }
   j["per_frame"] = per_frame;
   WriteFileAtomically((out / "run.json").string(),

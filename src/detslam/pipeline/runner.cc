@@ -138,6 +138,10 @@ class RunRecorder {
     if (r.mask_age >= 0) mask_age_.push_back(r.mask_age);
     if (r.keyframe_deferred) ++summary_.keyframes_deferred;
     if (r.keyframe_stale_masks) ++summary_.keyframes_stale_masks;
+    if (r.keyframe_cleaned >= 0) {
+      ++summary_.keyframes_cleaned;
+      summary_.keypoints_cleaned += static_cast<size_t>(r.keyframe_cleaned);
+    }
     summary_.reports.push_back(r);
     if (progress_) progress_(summary_.frames, total_, r);
   }
@@ -426,14 +430,14 @@ class SimulatedAsyncSegmentation {
 
   // Frames in input order, readable ones only.
   void Carry(const RgbdSource& dataset, SlamSystem* slam, LoadedFrame* f) {
-    if (pending_ && f->index >= pending_->ready) Publish();
+    if (pending_ && f->index >= pending_->ready) Publish(slam);
     if (!pending_) {
       const FrameInstances d = slam->DetectFrame(SegmentationInput(dataset, *f));
       detection_ms_.push_back(d.segmentation_ms);
       const bool first = carrier_.published() == 0;
       pending_ = Pending{f->index, f->index + (first ? 0 : frames_), f->images.gray,
-                         d.instances};
-      if (first) Publish();
+                         f->images.depth_m, d.instances};
+      if (first) Publish(slam);
     }
     if (std::optional<CarriedInstances> c = carrier_.Carry(f->index, f->images.gray))
       UseCarried(std::move(*c), f);
@@ -444,10 +448,11 @@ class SimulatedAsyncSegmentation {
  private:
   struct Pending {
     int64_t index, ready;
-    cv::Mat gray;
+    cv::Mat gray, depth_m;
     std::vector<Instance> instances;
   };
-  void Publish() {
+  void Publish(SlamSystem* slam) {
+    slam->OfferOwnMasks(pending_->index, pending_->instances, pending_->depth_m);
     carrier_.Publish(pending_->index, pending_->gray, std::move(pending_->instances));
     pending_.reset();
   }
@@ -592,6 +597,7 @@ RunSummary RunThreaded(const RgbdSource& dataset, const Settings& settings,
             if (StopRequested(options)) break;
             FrameInstances d = slam.DetectFrame(SegmentationInput(dataset, *f));
             detection_ms.push_back(d.segmentation_ms);
+            slam.OfferOwnMasks(f->index, d.instances, f->images.depth_m);
             carrier.Publish(f->index, f->images.gray, std::move(d.instances));
           }
         },

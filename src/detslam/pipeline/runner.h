@@ -140,6 +140,9 @@ struct RunSummary {
   ErrorStats mask_age;
   size_t keyframes_deferred = 0;
   size_t keyframes_stale_masks = 0;  // made with stale masks after waiting (FrameReport)
+  // DetSlamOptions::keyframe_clean_own_masks: keyframes cleaned by their own masks, and the
+  // keypoints that relabelled.
+  size_t keyframes_cleaned = 0, keypoints_cleaned = 0;
   int keyframes_mapped_in_burst = 0;  // SlamSystem::keyframes_mapped_in_burst
   size_t keyframe_masks = 0;  // written to out_dir/keyframe_masks
   DenseMapStats dense;        // of the dense map (dense_map)

@@ -366,11 +366,14 @@ KeyFrameId SlamSystem::TrackFrame(Frame frame, FrameReport* report, Frame* track
   const int to_map = keyframes_to_map_;
   mapping.idle = to_map == 0;
   mapping.queued = std::max(0, to_map - 1);
+  const DetSlamOptions& dyn = options_.dynamic;
+  // Before tracking, so that the frame does not match the points this drops.
+  if (report->mask_age >= 0 && dyn.keyframe_clean_own_masks)
+    report->keyframe_cleaned = CleanKeyFrameWithOwnMasks(map);
   report->tracking = tracker_.Track(map, &frame, mapping);
   if (report->tracking.interrupt_local_ba) abort_local_ba_ = true;
   KeyFrameId new_kf = kNoKeyFrame;
   // Asynchronous segmentation: masks carried over more than keyframe_max_mask_age frames.
-  const DetSlamOptions& dyn = options_.dynamic;
   const bool stale = report->mask_age > dyn.keyframe_max_mask_age;
   if (report->tracking.pose_valid && report->tracking.need_keyframe && !options_.localization) {
     // No new map points from stale masks, unless tracking is getting weak or the keyframe has
@@ -409,6 +412,51 @@ KeyFrameId SlamSystem::TrackFrame(Frame frame, FrameReport* report, Frame* track
   report->map_points = static_cast<int>(map.NumLandmarks());
   if (tracked != nullptr) *tracked = std::move(frame);
   return new_kf;
+}
+
+void SlamSystem::OfferOwnMasks(int64_t index, const std::vector<Instance>& instances,
+                               const cv::Mat& depth_m) {
+  if (!options_.dynamic.keyframe_clean_own_masks) return;
+  OwnMasks masks{index, dynamic_.Regions(instances, depth_m, cv::Size(camera_.width, camera_.height))};
+  const std::lock_guard<std::mutex> lock(offered_mutex_);
+  if (!offered_ || offered_->index < index) offered_ = std::move(masks);
+}
+
+int SlamSystem::CleanKeyFrameWithOwnMasks(Map& map) {
+  std::optional<OwnMasks> masks;
+  {
+    const std::lock_guard<std::mutex> lock(offered_mutex_);
+    masks.swap(offered_);
+  }
+  if (!masks) return -1;
+  // The keyframe made from that frame, if any (among the newest: masks come within a second).
+  KeyFrameId id = kNoKeyFrame;
+  int looked = 0;
+  for (auto it = map.keyframes().rbegin(); it != map.keyframes().rend() && looked < 30; ++it, ++looked) {
+    if (it->second.frame_index == masks->index) id = it->first;
+  }
+  if (id == kNoKeyFrame) return -1;
+  KeyFrame& kf = map.keyframe(id);
+  const FrameFeatures& f = *kf.features;
+  std::vector<KeypointLabel> labels(f.size(), KeypointLabel::kStatic);
+  masks->regions.Label(f.keypoints, f.depth, &labels);
+  if (kf.labels.size() != f.size()) kf.labels.assign(f.size(), KeypointLabel::kStatic);
+  int relabelled = 0;
+  for (size_t i = 0; i < f.size(); ++i) {
+    if (labels[i] == KeypointLabel::kStatic || kf.labels[i] != KeypointLabel::kStatic) continue;
+    kf.labels[i] = labels[i];
+    ++relabelled;
+    const LandmarkId lm = kf.landmarks[i];
+    if (lm == kNoLandmark || !map.HasLandmark(lm)) continue;
+    // A point this keyframe made lies on the object: gone; an older point only loses this view.
+    if (map.landmark(lm).first_keyframe == id) {
+      map.EraseLandmark(lm);
+    } else {
+      map.EraseObservation(lm, id);
+    }
+  }
+  if (relabelled > 0) map.UpdateConnections(id);
+  return relabelled;
 }
 
 Rigid3d SlamSystem::ReferenceWorldFromCam(const Map& map, KeyFrameId id,

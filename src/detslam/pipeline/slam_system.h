@@ -7,6 +7,7 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <opencv2/core.hpp>
 #include <string>
 #include <thread>
@@ -115,6 +116,9 @@ struct FrameReport {
   // (DetSlamOptions::keyframe_defer_min_inliers), it had waited keyframe_max_wait frames, or the
   // keyframe is a new map's first (a map starts whatever its masks' age).
   bool keyframe_stale_masks = false;
+  // DetSlamOptions::keyframe_clean_own_masks: the keypoints of an earlier keyframe relabelled by
+  // its own masks, published before this frame (-1: none this frame).
+  int keyframe_cleaned = -1;
   Timestamp stamp;
   TrackingResult tracking;
   bool keyframe = false;
@@ -184,6 +188,12 @@ class SlamSystem {
   // `tracked`, the frame as tracked (its keypoints' landmarks, outliers and labels) is moved there
   // (for a viewer).
   KeyFrameId TrackFrame(Frame frame, FrameReport* report, Frame* tracked = nullptr);
+  // Asynchronous segmentation with DetSlamOptions::keyframe_clean_own_masks: the detector's result
+  // for input frame `index` (its dynamic instances and the frame's depth, CV_32FC1 metres). If
+  // that frame became a keyframe (with carried masks), the next TrackFrame cleans the keyframe
+  // with them. Thread-safe (the segmentation thread calls it); a newer result replaces one not
+  // used yet.
+  void OfferOwnMasks(int64_t index, const std::vector<Instance>& instances, const cv::Mat& depth_m);
   // Local mapping stage: local mapping of a keyframe from TrackFrame and, unless loop closing has
   // a thread of its own (SlamOptions::loop_thread), its loop closing. Fills
   // report->timings.mapping_ms and the loop fields.
@@ -247,6 +257,11 @@ class SlamSystem {
   Rigid3d ReferenceWorldFromCam(const Map& map, KeyFrameId id, const Rigid3d& cam_from_ref,
                                 KeyFrameId* existing = nullptr) const;
 
+  // DetSlamOptions::keyframe_clean_own_masks: relabels the keyframe made from the frame of the
+  // newest offered masks (OfferOwnMasks), if any, by them and drops its landmarks there; returns
+  // the keypoints relabelled (-1: no such keyframe, or no masks offered since the last call).
+  int CleanKeyFrameWithOwnMasks(Map& map);
+
   PinholeCamera camera_;
   SlamOptions options_;
   OrbExtractor extractor_;
@@ -273,6 +288,13 @@ class SlamSystem {
   std::vector<LoopRecord> loops_;
   int64_t last_tracked_frame_ = -1;  // the newest frame TrackFrame has seen
   int64_t keyframe_wait_since_ = -1;  // the first frame whose keyframe was deferred (-1: none)
+  // DetSlamOptions::keyframe_clean_own_masks: the newest masks offered, not used yet.
+  struct OwnMasks {
+    int64_t index = -1;
+    DynamicRegions regions;
+  };
+  std::mutex offered_mutex_;
+  std::optional<OwnMasks> offered_;  // guarded by offered_mutex_
   std::vector<int64_t> global_ba_applied_;  // global_ba_applied_after_frames()
   std::thread global_ba_;  // with global_ba_thread: the running (or last) global BA
   int loop_generation_ = 0;  // loops corrected so far (a global BA started before one is stale)
