@@ -1,12 +1,15 @@
 // Kernels of the Det-SLAM stage that run on every frame (Google Benchmark, single thread): mask
 // dilation by the elliptic kernel (DilateEllipse against cv::dilate, on a person-sized mask and on
-// a full-frame mask as the mask propagation grows it), and carrying masks to the next frames
-// (MaskCarrier: optical flow + growth). Synthetic 640x480 images; no data needed.
+// a full-frame mask as the mask propagation grows it), carrying masks to the next frames
+// (MaskCarrier: optical flow + growth), and the regions a frame's masks become before its ORB
+// extraction (dilated masks, the depth step's interval, the ignore mask). Synthetic 640x480
+// images; no data needed.
 #include <benchmark/benchmark.h>
 
 #include <opencv2/core/utility.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "detslam/dynamic/dynamic_filter.h"
 #include "detslam/dynamic/ellipse_dilate.h"
 #include "detslam/dynamic/mask_carrier.h"
 #include "kernel_bench_main.h"
@@ -62,9 +65,12 @@ BENCHMARK(BM_DilateEllipse)->Arg(6)->Arg(15)->Arg(24)->Unit(benchmark::kMillisec
 // Carrying masks frame after frame as the camera-rate pipeline does: a new segmentation (of two
 // people) is published every `age` frames (its publishing, the segmentation thread's, is not
 // timed); each iteration carries the newest one to the next frame (the people move 4 px a frame).
+// Arguments: frames per segmentation, MaskPropagationOptions::flow_scale.
 void BM_MaskCarry(benchmark::State& state) {
   cv::setNumThreads(1);
   const int age = static_cast<int>(state.range(0));
+  detslam::MaskPropagationOptions propagation;
+  propagation.flow_scale = static_cast<int>(state.range(1));
   constexpr int kFrames = 8;  // distinct images, reused in turn
   std::vector<cv::Mat> frames;
   std::vector<std::vector<detslam::Instance>> people;
@@ -80,7 +86,7 @@ void BM_MaskCarry(benchmark::State& state) {
     }
     people.push_back(found);
   }
-  detslam::MaskCarrier carrier;
+  detslam::MaskCarrier carrier(propagation);
   int64_t index = 0;
   for (auto _ : state) {
     const int i = static_cast<int>(index % kFrames);
@@ -94,7 +100,44 @@ void BM_MaskCarry(benchmark::State& state) {
     benchmark::DoNotOptimize(carried);
   }
 }
-BENCHMARK(BM_MaskCarry)->Arg(1)->Arg(3)->Arg(6)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_MaskCarry)
+    ->ArgsProduct({{1, 3, 6}, {1, 2, 4}})
+    ->Unit(benchmark::kMillisecond);
+
+// What the Det-SLAM stage does with a frame's masks before ORB extraction: two people's regions
+// (mask dilated by the ORB patch radius, the paper's depth interval over the dominant depth mode)
+// and the ignore mask ORB skips. Depth: the room at 2.5-4 m, the people at about 1.4 and 1.9 m,
+// 5 % of pixels missing.
+void BM_RegionsAndIgnoreMask(benchmark::State& state) {
+  cv::setNumThreads(1);
+  cv::Mat depth(480, 640, CV_32FC1);
+  cv::RNG rng(5);
+  for (int y = 0; y < depth.rows; ++y) {
+    for (int x = 0; x < depth.cols; ++x) depth.at<float>(y, x) = 2.5f + 1.5f * x / depth.cols;
+  }
+  std::vector<detslam::Instance> people;
+  for (int shift : {-100, 100}) {
+    detslam::Instance person;
+    person.class_name = "person";
+    person.mask = PersonMask(shift);
+    person.box = cv::boundingRect(person.mask);
+    depth.setTo(shift < 0 ? 1.4 : 1.9, person.mask);
+    people.push_back(person);
+  }
+  cv::Mat noise(depth.size(), CV_32FC1);
+  rng.fill(noise, cv::RNG::NORMAL, 0.0, 0.01);
+  depth += noise;
+  cv::Mat missing(depth.size(), CV_32FC1);
+  rng.fill(missing, cv::RNG::UNIFORM, 0.0, 1.0);
+  depth.setTo(0.0f, missing < 0.05f);
+  const detslam::DynamicFilterOptions options;
+  for (auto _ : state) {
+    const auto regions = detslam::DynamicRegions::Build(people, depth, depth.size(), options);
+    cv::Mat ignore = regions.IgnoreMask(depth);
+    benchmark::DoNotOptimize(ignore.data);
+  }
+}
+BENCHMARK(BM_RegionsAndIgnoreMask)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 

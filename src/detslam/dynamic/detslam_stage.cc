@@ -95,7 +95,7 @@ LabelledKeypoints DetSlamStage::Extract(const OrbExtractor& extractor, const cv:
   LabelledKeypoints out;
   DynamicRegions regions;
   if (instances != nullptr) {
-    regions = DynamicRegions::Build(*instances, depth_m, gray.size(), options_.filter);
+    regions = Regions(*instances, depth_m, gray.size());
   }
   cv::Mat withheld = ignore_mask;
   if (instances != nullptr && !instances->empty()) {

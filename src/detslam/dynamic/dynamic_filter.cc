@@ -128,21 +128,28 @@ DepthRange DominantDepthMode(const std::vector<float>& depths, double bin_m, dou
   DETSLAM_CHECK_MSG(bin_m > 0.0 && window_m >= 0.5 * bin_m,
                     "bin_m " << bin_m << " window_m " << window_m);
   DepthRange out;
-  double lowest = std::numeric_limits<double>::infinity();
-  double highest = -lowest;
+  float lowest = std::numeric_limits<float>::infinity();
+  float highest = -lowest;
   for (float d : depths) {
     if (!ValidDepth(d)) continue;
-    lowest = std::min<double>(lowest, d);
-    highest = std::max<double>(highest, d);
+    lowest = std::min(lowest, d);
+    highest = std::max(highest, d);
   }
   if (!(lowest <= highest)) return out;
-  auto bin_of = [bin_m](double d) { return static_cast<int64_t>(std::floor(d / bin_m)); };
+  // Valid depths are positive and below kMaxDepthM, so the bin, floor(d / bin_m), is the
+  // quotient truncated; each depth's bin is computed once and kept for the last pass.
+  auto bin_of = [bin_m](float d) { return static_cast<int64_t>(static_cast<double>(d) / bin_m); };
   const int64_t first_bin = bin_of(lowest);
   const int64_t num_bins = bin_of(highest) - first_bin + 1;
   DETSLAM_CHECK_MSG(num_bins <= kMaxHistogramBins, "depth histogram too large: " << num_bins);
   std::vector<int> histogram(static_cast<size_t>(num_bins), 0);
+  std::vector<std::pair<float, int64_t>> binned;  // valid depths with their bin
+  binned.reserve(depths.size());
   for (float d : depths) {
-    if (ValidDepth(d)) ++histogram[static_cast<size_t>(bin_of(d) - first_bin)];
+    if (!ValidDepth(d)) continue;
+    const int64_t bin = bin_of(d) - first_bin;
+    ++histogram[static_cast<size_t>(bin)];
+    binned.emplace_back(d, bin);
   }
   // The most populated bin; ties go to the nearer bin (max_element returns the first maximum).
   const int64_t mode = std::max_element(histogram.begin(), histogram.end()) - histogram.begin();
@@ -154,17 +161,17 @@ DepthRange DominantDepthMode(const std::vector<float>& depths, double bin_m, dou
   while (run_lo > 0 && histogram[static_cast<size_t>(run_lo - 1)] >= populated) --run_lo;
   while (run_hi + 1 < num_bins && histogram[static_cast<size_t>(run_hi + 1)] >= populated) ++run_hi;
   const double centre = (static_cast<double>(first_bin + mode) + 0.5) * bin_m;
-  for (float d : depths) {
-    if (!ValidDepth(d)) continue;
-    const int64_t bin = bin_of(d) - first_bin;
+  float kept_min = std::numeric_limits<float>::infinity();
+  float kept_max = -kept_min;
+  for (const auto& [d, bin] : binned) {
     if (bin < run_lo || bin > run_hi || std::abs(d - centre) > window_m) continue;
-    if (!out.valid) {
-      out.valid = true;
-      out.min = out.max = d;
-    } else {
-      out.min = std::min<double>(out.min, d);
-      out.max = std::max<double>(out.max, d);
-    }
+    kept_min = std::min(kept_min, d);
+    kept_max = std::max(kept_max, d);
+  }
+  if (kept_min <= kept_max) {
+    out.valid = true;
+    out.min = kept_min;
+    out.max = kept_max;
   }
   return out;
 }
@@ -177,21 +184,23 @@ DepthInterval ObjectDepthInterval(const cv::Mat& depth_m, const cv::Mat& mask, c
   CheckMask(mask, depth_m.size());
   const cv::Rect clipped = box & cv::Rect(0, 0, depth_m.cols, depth_m.rows);
   if (clipped.empty()) return out;
-  std::vector<float> object;
-  object.reserve(static_cast<size_t>(clipped.area()));
-  double roi_min = std::numeric_limits<double>::infinity();
-  double roi_max = -roi_min;
+  std::vector<float> object(static_cast<size_t>(clipped.area()));
+  size_t count = 0;  // of `object`: the valid depths under the mask
+  float roi_min = std::numeric_limits<float>::infinity();
+  float roi_max = -roi_min;
   for (int y = clipped.y; y < clipped.y + clipped.height; ++y) {
     const float* depth_row = depth_m.ptr<float>(y);
     const uint8_t* mask_row = mask.empty() ? nullptr : mask.ptr<uint8_t>(y);
     for (int x = clipped.x; x < clipped.x + clipped.width; ++x) {
       const float d = depth_row[x];
       if (!ValidDepth(d)) continue;
-      roi_min = std::min<double>(roi_min, d);
-      roi_max = std::max<double>(roi_max, d);
-      if (mask_row == nullptr || mask_row[x] != 0) object.push_back(d);
+      roi_min = std::min(roi_min, d);
+      roi_max = std::max(roi_max, d);
+      object[count] = d;
+      count += mask_row == nullptr || mask_row[x] != 0 ? 1 : 0;
     }
   }
+  object.resize(count);
   DepthRange mode;
   if (options.dominant_mode) {
     mode = DominantDepthMode(object, options.depth_bin_m, options.mode_window_m,
@@ -203,7 +212,7 @@ DepthInterval ObjectDepthInterval(const cv::Mat& depth_m, const cv::Mat& mask, c
   if (!mode.valid) return out;
   out.m_obj = mode.min;
   out.M_obj = mode.max;
-  out.d_roi = roi_max - roi_min;
+  out.d_roi = static_cast<double>(roi_max) - static_cast<double>(roi_min);
   out.lo = out.m_obj - options.alpha * out.d_roi;
   out.hi = out.M_obj + options.alpha * out.d_roi;
   out.valid = true;

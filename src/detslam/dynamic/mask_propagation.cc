@@ -29,6 +29,7 @@ bool MaskPropagationOptions::Check(std::string* error) const {
   if (max_corners < 1) os << "max_corners must be >= 1; ";
   if (grow_px_per_frame < 0) os << "grow_px_per_frame must be >= 0; ";
   if (min_tracked < 1) os << "min_tracked must be >= 1; ";
+  if (flow_scale != 1 && flow_scale != 2 && flow_scale != 4) os << "flow_scale must be 1, 2 or 4; ";
   if (error) *error = os.str();
   return os.str().empty();
 }
@@ -56,9 +57,21 @@ cv::Mat ShiftMask(const cv::Mat& mask, double dx, double dy) {
   return out;
 }
 
+cv::Mat MaskPropagator::Reduced(const cv::Mat& gray) const {
+  if (options_.flow_scale == 1) return gray.clone();
+  cv::Mat out = gray;
+  for (int s = options_.flow_scale; s > 1; s /= 2) {
+    cv::Mat half;
+    cv::pyrDown(out, half);
+    out = half;
+  }
+  return out;
+}
+
 void MaskPropagator::Reset(const cv::Mat& gray, std::vector<Instance> instances) {
   DETSLAM_CHECK(gray.type() == CV_8UC1);
-  last_gray_ = gray.clone();
+  last_gray_ = Reduced(gray);
+  full_size_ = gray.size();
   last_pyramid_.clear();
   instances_ = std::move(instances);
   age_ = 0;
@@ -68,33 +81,57 @@ std::vector<Instance> MaskPropagator::Propagate(const cv::Mat& gray, int frames)
   DETSLAM_CHECK(gray.type() == CV_8UC1);
   DETSLAM_CHECK(frames >= 1);
   if (last_gray_.empty()) return {};
-  DETSLAM_CHECK_MSG(gray.size() == last_gray_.size(), "image size changed during the sequence");
+  DETSLAM_CHECK_MSG(gray.size() == full_size_, "image size changed during the sequence");
   age_ += frames;
   const cv::Rect image(0, 0, gray.cols, gray.rows);
-  const cv::Size window(21, 21);
-  constexpr int kLevels = 3;
+  // A 21-pixel window at full resolution, over 3 pyramid levels above the images: the reduced
+  // images' window is as wide in the full image (odd), and their pyramid as deep, so that the
+  // search reaches at least as far in full-resolution pixels (the window's half-width times 2^3
+  // at the coarsest level).
+  const int scale = options_.flow_scale;
+  const int side = std::max(5, (21 / scale) | 1);
+  const cv::Size window(side, side);
+  constexpr int levels = 3;
+  const cv::Mat small = Reduced(gray);
+  const cv::Rect small_image(0, 0, small.cols, small.rows);
   // Both images' pyramids are built once per call (not once per instance); this frame's is the
   // next call's previous one.
   std::vector<cv::Mat> pyramid;
   if (!instances_.empty()) {
-    if (last_pyramid_.empty()) cv::buildOpticalFlowPyramid(last_gray_, last_pyramid_, window, kLevels);
-    cv::buildOpticalFlowPyramid(gray, pyramid, window, kLevels);
+    if (last_pyramid_.empty()) cv::buildOpticalFlowPyramid(last_gray_, last_pyramid_, window, levels);
+    cv::buildOpticalFlowPyramid(small, pyramid, window, levels);
   }
   for (Instance& inst : instances_) {
-    // Corners inside the instance, searched in its box only (not over the whole image).
-    const cv::Rect roi = inst.box & image;
+    // Corners inside the instance, searched in its box only (not over the whole image), in the
+    // reduced images: the box rounded outwards, the mask reduced by nearest neighbour.
+    const cv::Rect box = inst.box & image;
+    const cv::Rect roi =
+        cv::Rect(cv::Point(box.x / scale, box.y / scale),
+                 cv::Point((box.x + box.width + scale - 1) / scale,
+                           (box.y + box.height + scale - 1) / scale)) &
+        small_image;
     cv::Mat region;
-    if (!inst.mask.empty()) region = inst.mask(roi);
+    if (!inst.mask.empty() && !roi.empty()) {
+      if (scale == 1) {
+        region = inst.mask(roi);
+      } else {
+        const cv::Rect full = cv::Rect(roi.x * scale, roi.y * scale, roi.width * scale,
+                                       roi.height * scale) & image;
+        cv::resize(inst.mask(full), region, roi.size(), 0, 0, cv::INTER_NEAREST);
+      }
+    }
     std::vector<cv::Point2f> from, to;
     if (!roi.empty()) {
-      cv::goodFeaturesToTrack(last_gray_(roi), from, options_.max_corners, 0.01, 5, region);
+      const double min_distance = std::max(2.0, 5.0 / scale);
+      cv::goodFeaturesToTrack(last_gray_(roi), from, options_.max_corners, 0.01, min_distance,
+                              region);
       for (cv::Point2f& p : from) p += cv::Point2f(static_cast<float>(roi.x), static_cast<float>(roi.y));
     }
     double dx = 0, dy = 0;
     if (!from.empty()) {
       std::vector<uchar> status;
       std::vector<float> err;
-      cv::calcOpticalFlowPyrLK(last_pyramid_, pyramid, from, to, status, err, window, kLevels);
+      cv::calcOpticalFlowPyrLK(last_pyramid_, pyramid, from, to, status, err, window, levels);
       std::vector<float> fx, fy;
       for (size_t i = 0; i < from.size(); ++i) {
         if (!status[i]) continue;
@@ -102,8 +139,8 @@ std::vector<Instance> MaskPropagator::Propagate(const cv::Mat& gray, int frames)
         fy.push_back(to[i].y - from[i].y);
       }
       if (static_cast<int>(fx.size()) >= options_.min_tracked) {
-        dx = MedianOf(fx);
-        dy = MedianOf(fy);
+        dx = scale * MedianOf(fx);
+        dy = scale * MedianOf(fy);
       }
     }
     inst.mask = ShiftMask(inst.mask, dx, dy);
@@ -114,7 +151,7 @@ std::vector<Instance> MaskPropagator::Propagate(const cv::Mat& gray, int frames)
   instances_.erase(std::remove_if(instances_.begin(), instances_.end(),
                                   [](const Instance& i) { return i.box.empty(); }),
                    instances_.end());  // moved out of view
-  last_gray_ = gray.clone();
+  last_gray_ = small;
   last_pyramid_ = std::move(pyramid);
   std::vector<Instance> out = instances_;
   const int grow = options_.grow_px_per_frame * age_;

@@ -87,6 +87,34 @@ TEST(MaskPropagation, AJumpOverSeveralFramesGrowsTheMaskByTheirNumber) {
   EXPECT_DEATH(p.Propagate(SquareImage({112, 86}), 0), "");
 }
 
+// The flow on reduced images: the same motion found, within a pixel, at every scale; a box whose
+// corner is not on the reduced grid (odd coordinates) too.
+class ReducedFlow : public ::testing::TestWithParam<int> {};
+
+TEST_P(ReducedFlow, FollowsTheObjectAsAtFullResolution) {
+  MaskPropagationOptions o;
+  o.grow_px_per_frame = 0;
+  o.flow_scale = GetParam();
+  MaskPropagator p(o);
+  p.Reset(SquareImage({101, 81}), {Square({101, 81})});
+  std::vector<Instance> out = p.Propagate(SquareImage({108, 84}));
+  ASSERT_EQ(out.size(), 1u);
+  cv::Point2d c = Centroid(out[0].mask);
+  EXPECT_NEAR(c.x, 138.5, 1.0);
+  EXPECT_NEAR(c.y, 113.5, 1.0);
+  // A larger step over three frames, then back: the mask ends where the object is.
+  out = p.Propagate(SquareImage({125, 70}), 3);
+  ASSERT_EQ(out.size(), 1u);
+  c = Centroid(out[0].mask);
+  EXPECT_NEAR(c.x, 154.5, 1.0);
+  EXPECT_NEAR(c.y, 99.5, 1.0);
+  EXPECT_NEAR(out[0].box.x, 125, 1);
+  EXPECT_NEAR(out[0].box.y, 70, 1);
+  EXPECT_EQ(out[0].box.size(), cv::Size(60, 60));
+}
+
+INSTANTIATE_TEST_SUITE_P(MaskPropagation, ReducedFlow, ::testing::Values(1, 2, 4));
+
 TEST(MaskCarrier, NothingBeforeTheFirstPublishedSegmentation) {
   MaskCarrier carrier;
   EXPECT_FALSE(carrier.Carry(0, SquareImage({50, 50})).has_value());
@@ -197,6 +225,10 @@ TEST(MaskPropagation, RejectsInvalidOptions) {
   EXPECT_FALSE(o.Check(&error));
   EXPECT_NE(error.find("max_corners"), std::string::npos);
   EXPECT_DEATH(MaskPropagator{o}, "");
+  o = MaskPropagationOptions();
+  o.flow_scale = 3;
+  EXPECT_FALSE(o.Check(&error));
+  EXPECT_NE(error.find("flow_scale"), std::string::npos);
 }
 
 }  // namespace

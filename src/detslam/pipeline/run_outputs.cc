@@ -280,6 +280,7 @@ void WriteRunOutputs(const RgbdSource& dataset, const Settings& settings, const 
                                                          ? options.camera_rate_region_frames
                                                          : dyn.geometric.region_frames},
                          {"segment_every", dyn.segment_every},
+                         {"flow_scale", dyn.propagation.flow_scale},
                          {"keyframe_max_mask_age", dyn.keyframe_max_mask_age},
                          {"keyframe_max_wait", dyn.keyframe_max_wait},
                          {"keyframe_defer_min_inliers", dyn.keyframe_defer_min_inliers},

@@ -433,7 +433,10 @@ int SlamSystem::CleanKeyFrameWithOwnMasks(Map& map) {
   KeyFrameId id = kNoKeyFrame;
   int looked = 0;
   for (auto it = map.keyframes().rbegin(); it != map.keyframes().rend() && looked < 30; ++it, ++looked) {
-    if (it->second.frame_index == masks->index) id = it->first;
+    if (it->second.frame_index == masks->index) {
+      id = it->first;  // one keyframe per frame at most
+      break;
+    }
   }
   if (id == kNoKeyFrame) return -1;
   KeyFrame& kf = map.keyframe(id);
