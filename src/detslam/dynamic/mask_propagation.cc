@@ -91,15 +91,15 @@ std::vector<Instance> MaskPropagator::Propagate(const cv::Mat& gray, int frames)
   const int scale = options_.flow_scale;
   const int side = std::max(5, (21 / scale) | 1);
   const cv::Size window(side, side);
-  constexpr int levels = 3;
+  constexpr int kLevels = 3;
   const cv::Mat small = Reduced(gray);
   const cv::Rect small_image(0, 0, small.cols, small.rows);
   // Both images' pyramids are built once per call (not once per instance); this frame's is the
   // next call's previous one.
   std::vector<cv::Mat> pyramid;
   if (!instances_.empty()) {
-    if (last_pyramid_.empty()) cv::buildOpticalFlowPyramid(last_gray_, last_pyramid_, window, levels);
-    cv::buildOpticalFlowPyramid(small, pyramid, window, levels);
+    if (last_pyramid_.empty()) cv::buildOpticalFlowPyramid(last_gray_, last_pyramid_, window, kLevels);
+    cv::buildOpticalFlowPyramid(small, pyramid, window, kLevels);
   }
   for (Instance& inst : instances_) {
     // Corners inside the instance, searched in its box only (not over the whole image), in the
@@ -131,7 +131,7 @@ std::vector<Instance> MaskPropagator::Propagate(const cv::Mat& gray, int frames)
     if (!from.empty()) {
       std::vector<uchar> status;
       std::vector<float> err;
-      cv::calcOpticalFlowPyrLK(last_pyramid_, pyramid, from, to, status, err, window, levels);
+      cv::calcOpticalFlowPyrLK(last_pyramid_, pyramid, from, to, status, err, window, kLevels);
       std::vector<float> fx, fy;
       for (size_t i = 0; i < from.size(); ++i) {
         if (!status[i]) continue;
