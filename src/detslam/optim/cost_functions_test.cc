@@ -35,11 +35,14 @@ TEST(CostFunctionsTest, MonoResidualHandMade) {
   std::unique_ptr<ceres::CostFunction> cost(
       MonoReprojectionCost::Create(HandIntrinsics(), Eigen::Vector2d(390, 230), 0.5));
   const double* params[] = {kQ, kT, kP};
-  double r[2];
+  double r[3] = {1.0, 1.0, 1.0};
   ASSERT_TRUE(cost->Evaluate(params, r, nullptr));
-  EXPECT_EQ(cost->num_residuals(), 2);
+  // Three rows like the stereo residual (one block shape for Ceres's Schur eliminator); the third
+  // is exactly 0.
+  EXPECT_EQ(cost->num_residuals(), 3);
   EXPECT_NEAR(r[0], 0.5 * 5.0, 1e-12);
   EXPECT_NEAR(r[1], 0.5 * -10.0, 1e-12);
+  EXPECT_EQ(r[2], 0.0);
 }
 
 // Probes the Jacobians (in the quaternion's tangent space) against numeric differentiation at a
