@@ -19,28 +19,16 @@ namespace {
 
 using detslam::BundleProblem;
 
-detslam::PinholeCamera Camera() {
-  detslam::PinholeCamera c;
-  c.width = 640;
-  c.height = 480;
-  c.fx = 525;
-  c.fy = 525;
-  c.cx = 319.5;
-  c.cy = 239.5;
-  c.bf = 40;
-  return c;
-}
-
 // Keyframes 6 cm apart along x, turning slowly, looking at points 1-4 m away; each point is
 // observed by the keyframes near the one that made it (a track of up to 8) where it projects into
-// the image. Observations carry 1 px noise (disparity with the camera's disparity sigma), 5 % are outliers (30 px off); the
-// optimised keyframes start 1 cm / 0.3 degrees off, the points 2 cm off.
+// the image. Observations carry 1 px noise (the disparity its sigma), 5 % are outliers (30 px
+// off); the optimised keyframes start 1 cm / 0.3 degrees off, the points 2 cm off.
 BundleProblem MakeProblem(int free_poses, int fixed_poses, int points_per_keyframe,
                           double mono_share, unsigned seed) {
   std::mt19937 rng(seed);
   std::normal_distribution<double> n01(0.0, 1.0);
   std::uniform_real_distribution<double> u01(0.0, 1.0);
-  const detslam::PinholeCamera cam = Camera();
+  const detslam::PinholeCamera cam;  // 640 x 480, TUM-like intrinsics, bf 40
   BundleProblem p;
   const int num_poses = fixed_poses + free_poses;
   std::vector<detslam::Rigid3d> truth;
@@ -103,7 +91,7 @@ BundleProblem MakeProblem(int free_poses, int fixed_poses, int points_per_keyfra
 
 void BM_LocalBundle(benchmark::State& state) {
   const BundleProblem problem = MakeProblem(20, 20, 120, state.range(0) / 100.0, 7);
-  const detslam::PinholeCamera cam = Camera();
+  const detslam::PinholeCamera cam;
   detslam::BundleOptions options;
   options.max_iterations = 10;
   int iterations = 0;

@@ -27,7 +27,7 @@ struct StereoIntrinsics {
 // coordinates, as Ceres's manifold expects). Always 3 residuals: (u, v, depth) for an observation
 // with depth, (u, v, 0) without, so that every block of a bundle has the same shape and Ceres
 // takes its fixed-size Schur eliminator (3, 3, 3) instead of the dynamic one. With rows of 2 and
-// 3 and automatic differentiation a local bundle took 1.5-2 times as long (BM_LocalBundle). The
+// 3 and automatic differentiation a local bundle took about 1.5 times as long (BM_LocalBundle). The
 // third residual of a mono observation and its Jacobian row are exactly 0, so the cost, its
 // gradient and the normal equations are those of the 2-residual model.
 class ReprojectionCost : public ceres::SizedCostFunction<3, 4, 3, 3> {
