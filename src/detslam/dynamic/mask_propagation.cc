@@ -98,7 +98,9 @@ std::vector<Instance> MaskPropagator::Propagate(const cv::Mat& gray, int frames)
   // next call's previous one.
   std::vector<cv::Mat> pyramid;
   if (!instances_.empty()) {
-    if (last_pyramid_.empty()) cv::buildOpticalFlowPyramid(last_gray_, last_pyramid_, window, kLevels);
+    if (last_pyramid_.empty()) {
+      cv::buildOpticalFlowPyramid(last_gray_, last_pyramid_, window, kLevels);
+    }
     cv::buildOpticalFlowPyramid(small, pyramid, window, kLevels);
   }
   for (Instance& inst : instances_) {
@@ -125,7 +127,8 @@ std::vector<Instance> MaskPropagator::Propagate(const cv::Mat& gray, int frames)
       const double min_distance = std::max(2.0, 5.0 / scale);
       cv::goodFeaturesToTrack(last_gray_(roi), from, options_.max_corners, 0.01, min_distance,
                               region);
-      for (cv::Point2f& p : from) p += cv::Point2f(static_cast<float>(roi.x), static_cast<float>(roi.y));
+      const cv::Point2f origin(static_cast<float>(roi.x), static_cast<float>(roi.y));
+      for (cv::Point2f& p : from) p += origin;
     }
     double dx = 0, dy = 0;
     if (!from.empty()) {

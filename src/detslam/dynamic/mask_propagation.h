@@ -19,8 +19,9 @@ struct MaskPropagationOptions {
   int min_tracked = 3;        // fewer tracked corners: the instance keeps its place (still grown)
   // The optical flow runs on the images reduced by this factor (1, 2 or 4; each halving is a
   // cv::pyrDown), with the window reduced with them and the same 3 pyramid levels, so that the
-  // search reaches as far in full-resolution pixels; the median flow is scaled back. A person's shift needs no full-resolution flow:
-  // the mask moves by whole pixels and grows grow_px_per_frame per frame anyway. 2 chosen on the
+  // search reaches as far in full-resolution pixels; the median flow is scaled back. A person's
+  // shift needs no full-resolution flow: the mask moves by whole pixels and grows
+  // grow_px_per_frame per frame anyway. 2 chosen on the
   // tuning seeds (docs/STATUS.md): carried masks as complete as with 1, the carry 2.5x faster.
   int flow_scale = 2;
   bool Check(std::string* error) const;

@@ -1,15 +1,8 @@
 #include "detslam/optim/cost_functions.h"
 
+#include "detslam/core/rigid3d.h"
+
 namespace detslam {
-namespace {
-
-Eigen::Matrix3d Skew(const Eigen::Vector3d& a) {
-  Eigen::Matrix3d m;
-  m << 0.0, -a.z(), a.y(), a.z(), 0.0, -a.x(), -a.y(), a.x(), 0.0;
-  return m;
-}
-
-}  // namespace
 
 bool ReprojectionCost::Evaluate(double const* const* parameters, double* residuals,
                                 double** jacobians) const {
@@ -52,7 +45,7 @@ bool ReprojectionCost::Evaluate(double const* const* parameters, double* residua
   if (jacobians[0] != nullptr) {
     // d p_cam / d u = -2 w [p]x + 2 (u.p) I + 2 u p^T - 4 p u^T; d p_cam / d w = 2 (u x p).
     Eigen::Matrix<double, 3, 4> d_q;
-    d_q.leftCols<3>() = -2.0 * w * Skew(p) + 2.0 * u.dot(p) * Eigen::Matrix3d::Identity() +
+    d_q.leftCols<3>() = -2.0 * w * Hat(p) + 2.0 * u.dot(p) * Eigen::Matrix3d::Identity() +
                         2.0 * u * p.transpose() - 4.0 * p * u.transpose();
     d_q.col(3) = 2.0 * uxp;
     Eigen::Map<Eigen::Matrix<double, 3, 4, Eigen::RowMajor>> j_q(jacobians[0]);
@@ -64,7 +57,7 @@ bool ReprojectionCost::Evaluate(double const* const* parameters, double* residua
   }
   if (jacobians[2] != nullptr) {
     // d p_cam / d p = I + 2 w [u]x + 2 [u]x^2 (the rotation matrix for a unit q).
-    const Eigen::Matrix3d su = Skew(u);
+    const Eigen::Matrix3d su = Hat(u);
     const Eigen::Matrix3d d_p = Eigen::Matrix3d::Identity() + 2.0 * w * su + 2.0 * su * su;
     Eigen::Map<Eigen::Matrix<double, 3, 3, Eigen::RowMajor>> j_p(jacobians[2]);
     j_p = d_pc * d_p;
