@@ -9,7 +9,8 @@
 # label). CXX_COMPILER=clang++ builds with clang; FUZZ=1 (address only, implies clang) also
 # instruments the parsers' modules for libFuzzer and builds the fuzz targets in the same folder, for
 # `REUSE_BUILD=1 BUILD_DIR=... scripts/fuzz.sh`; UNITY=1 makes a unity build (several sources
-# per compiler run: about half the time from scratch, as CI builds).
+# per compiler run: about half the time from scratch, as CI builds); BUILD_ONLY=1 builds and stops
+# (CI builds the sanitizer folders in the background while the Release tests run).
 set -euo pipefail
 ROOT=$(cd "$(dirname "$0")/.." && pwd)
 kind=${1:-address}
@@ -45,6 +46,7 @@ else
   cmake --build "$BUILD_DIR" -j "$JOBS"
 fi
 echo "[sanitize] $kind build: $(( $(date +%s) - start )) s"
+if [ -n "${BUILD_ONLY:-}" ]; then exit 0; fi
 
 supp="$ROOT/scripts/sanitizers"
 export ASAN_OPTIONS="abort_on_error=1:detect_leaks=1:detect_stack_use_after_return=1:strict_string_checks=1"
