@@ -1,7 +1,5 @@
 #include "detslam/mapping/landmark_fusion.h"
 
-#include <algorithm>
-
 namespace detslam {
 
 int FuseLandmarksInto(const PinholeCamera& camera, Map& map, KeyFrameId into,
@@ -15,16 +13,8 @@ int FuseLandmarksInto(const PinholeCamera& camera, Map& map, KeyFrameId into,
     cands.push_back(CandidateFromLandmark(lm));
   }
   const KeyFrame& kf = map.keyframe(into);
-  // Keypoints the tracker's geometric check labelled as movers take no landmark (as they get none
-  // from triangulation): SearchByProjection skips them.
-  std::vector<bool> movers;
-  if (std::any_of(kf.labels.begin(), kf.labels.end(),
-                  [](KeypointLabel l) { return l != KeypointLabel::kStatic; })) {
-    movers.resize(kf.size());
-    for (size_t i = 0; i < kf.labels.size(); ++i) movers[i] = kf.labels[i] != KeypointLabel::kStatic;
-  }
   const std::vector<int> m =
-      SearchByProjection(camera, map.scale(), *kf.features, cam_from_world, cands, movers, options);
+      SearchByProjection(camera, map.scale(), *kf.features, cam_from_world, cands, {}, options);
   int fused = 0;
   for (size_t c = 0; c < cands.size(); ++c) {
     if (m[c] < 0 || !map.HasLandmark(cands[c].landmark)) continue;
