@@ -91,7 +91,8 @@ DynamicRegions DetSlamStage::Regions(const std::vector<Instance>& instances,
 
 LabelledKeypoints DetSlamStage::Extract(const OrbExtractor& extractor, const cv::Mat& gray,
                                         const cv::Mat& depth_m, const cv::Mat& ignore_mask,
-                                        const std::vector<Instance>* instances) const {
+                                        const std::vector<Instance>* instances,
+                                        const OrbPyramid* pyramid) const {
   LabelledKeypoints out;
   DynamicRegions regions;
   if (instances != nullptr) {
@@ -107,8 +108,12 @@ LabelledKeypoints DetSlamStage::Extract(const OrbExtractor& extractor, const cv:
       cv::bitwise_or(ignore_mask, dynamic, withheld);
     }
   }
-  extractor.Extract(gray, options_.premask ? withheld : ignore_mask, &out.keypoints,
-                    &out.descriptors);
+  const cv::Mat& extraction_mask = options_.premask ? withheld : ignore_mask;
+  if (pyramid != nullptr) {
+    extractor.Extract(*pyramid, extraction_mask, &out.keypoints, &out.descriptors);
+  } else {
+    extractor.Extract(gray, extraction_mask, &out.keypoints, &out.descriptors);
+  }
   out.withheld = withheld;
   out.depth = SampleKeypointDepth(out.keypoints, depth_m);
   out.labels.assign(out.keypoints.size(), KeypointLabel::kStatic);

@@ -89,10 +89,11 @@ class DetSlamStage {
 
   // Extraction side: ORB keypoints of `gray` with their depth and labels. `instances`: null when
   // the frame was not segmented (every keypoint static). `ignore_mask`: empty or CV_8UC1,
-  // non-zero = no keypoints there.
+  // non-zero = no keypoints there. `pyramid`: null, or extractor.Prepare(gray) computed earlier.
   LabelledKeypoints Extract(const OrbExtractor& extractor, const cv::Mat& gray,
                             const cv::Mat& depth_m, const cv::Mat& ignore_mask,
-                            const std::vector<Instance>* instances) const;
+                            const std::vector<Instance>* instances,
+                            const OrbPyramid* pyramid = nullptr) const;
   // The regions Extract would label a frame's keypoints with (mask step and depth step), for
   // labelling keypoints extracted earlier (keyframes cleaned by their own masks). `depth_m`: the
   // frame's depth (CV_32FC1 metres, 0 = missing) of `image_size`.

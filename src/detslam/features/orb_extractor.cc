@@ -123,12 +123,28 @@ bool CellFullyMasked(const cv::Mat& mask, double scale, int x_begin, int x_end, 
 }
 
 // FAST corners (with non-max suppression) of one level inside [kDetectBorder, size -
-// kDetectBorder), by cells of about kCellSize pixels: the whole area at ini_th_fast first, then, in
-// each cell that has no (unmasked) corner, that cell again at min_th_fast (not if the mask covers
-// the whole cell: nothing found there could be kept). Corners whose level-0 position is masked are
-// dropped before the per-cell decision. Positions are level pixel coordinates.
+// kDetectBorder), by cells of about kCellSize pixels: the whole area at ini_th_fast first
+// (DetectStrongCorners, no mask needed), then, in DetectCorners, in each cell that has no
+// (unmasked) corner, that cell again at min_th_fast (not if the mask covers the whole cell:
+// nothing found there could be kept). Corners whose level-0 position is masked are dropped before
+// the per-cell decision. Positions are level pixel coordinates.
+std::vector<cv::KeyPoint> DetectStrongCorners(const cv::Mat& level_image, const OrbOptions& options) {
+  constexpr int kMargin = kDetectBorder - kFastRadius;
+  std::vector<cv::KeyPoint> found;
+  cv::FAST(level_image(cv::Rect(kMargin, kMargin, level_image.cols - 2 * kMargin,
+                                level_image.rows - 2 * kMargin)),
+           found, options.ini_th_fast, true);
+  for (cv::KeyPoint& kp : found) {
+    kp.pt.x += kMargin;
+    kp.pt.y += kMargin;
+  }
+  return found;
+}
+
+// The level's corners outside the mask from its strong corners (see above).
 void DetectCorners(const cv::Mat& level_image, double scale, const cv::Mat& ignore_mask,
-                   const OrbOptions& options, std::vector<cv::KeyPoint>* corners) {
+                   const OrbOptions& options, const std::vector<cv::KeyPoint>& strong,
+                   std::vector<cv::KeyPoint>* corners) {
   corners->clear();
   const int region_w = level_image.cols - 2 * kDetectBorder;
   const int region_h = level_image.rows - 2 * kDetectBorder;
@@ -140,16 +156,8 @@ void DetectCorners(const cv::Mat& level_image, double scale, const cv::Mat& igno
     return ignore_mask.empty() || !Masked(ignore_mask, kp.pt.x * scale, kp.pt.y * scale);
   };
 
-  // Strong corners over the whole area (FAST cannot fire within 3 px of the area's edge).
-  constexpr int kMargin = kDetectBorder - kFastRadius;
-  std::vector<cv::KeyPoint> found;
-  cv::FAST(level_image(cv::Rect(kMargin, kMargin, level_image.cols - 2 * kMargin,
-                                level_image.rows - 2 * kMargin)),
-           found, options.ini_th_fast, true);
   std::vector<char> cell_has_corner(cols * rows, 0);
-  for (cv::KeyPoint& kp : found) {
-    kp.pt.x += kMargin;
-    kp.pt.y += kMargin;
+  for (const cv::KeyPoint& kp : strong) {
     if (!keep(kp)) continue;
     const int cx = std::clamp(static_cast<int>((kp.pt.x - kDetectBorder) / cell_w), 0, cols - 1);
     const int cy = std::clamp(static_cast<int>((kp.pt.y - kDetectBorder) / cell_h), 0, rows - 1);
@@ -172,7 +180,7 @@ void DetectCorners(const cv::Mat& level_image, double scale, const cv::Mat& igno
       }
       const cv::Rect roi(x_begin - kFastRadius, y_begin - kFastRadius,
                          x_end - x_begin + 2 * kFastRadius, y_end - y_begin + 2 * kFastRadius);
-      found.clear();
+      std::vector<cv::KeyPoint> found;
       cv::FAST(level_image(roi), found, options.min_th_fast, true);
       for (cv::KeyPoint& kp : found) {
         kp.pt.x += roi.x;
@@ -235,14 +243,41 @@ OrbExtractor::OrbExtractor(const OrbOptions& options) : options_(options) {
   features_per_level_[levels - 1] = std::max(0, options_.num_features - assigned);
 }
 
-void OrbExtractor::Extract(const cv::Mat& gray, const cv::Mat& ignore_mask,
-                           std::vector<cv::KeyPoint>* keypoints, cv::Mat* descriptors) const {
-  DETSLAM_CHECK(keypoints != nullptr && descriptors != nullptr);
+OrbPyramid OrbExtractor::Prepare(const cv::Mat& gray) const {
   if (gray.empty() || gray.type() != CV_8UC1) {
     throw InputError("OrbExtractor::Extract: image must be a non-empty CV_8UC1 image");
   }
+  OrbPyramid pyramid;
+  pyramid.size = gray.size();
+  for (int level = 0; level < options_.num_levels; ++level) {
+    const cv::Size size(static_cast<int>(std::lround(gray.cols * inv_scale_factors_[level])),
+                        static_cast<int>(std::lround(gray.rows * inv_scale_factors_[level])));
+    if (size.width <= 2 * kDetectBorder + 1 || size.height <= 2 * kDetectBorder + 1) break;
+    OrbPyramid::Level l;
+    if (level == 0) {
+      l.image = gray;
+    } else {
+      cv::resize(pyramid.levels.back().image, l.image, size, 0, 0, cv::INTER_LINEAR);
+    }
+    cv::copyMakeBorder(l.image, l.padded, kEdgeThreshold, kEdgeThreshold, kEdgeThreshold,
+                       kEdgeThreshold, cv::BORDER_REFLECT_101);
+    cv::GaussianBlur(l.padded, l.blurred, cv::Size(7, 7), 2, 2, cv::BORDER_REFLECT_101);
+    l.strong = DetectStrongCorners(l.image, options_);
+    pyramid.levels.push_back(std::move(l));
+  }
+  return pyramid;
+}
+
+void OrbExtractor::Extract(const cv::Mat& gray, const cv::Mat& ignore_mask,
+                           std::vector<cv::KeyPoint>* keypoints, cv::Mat* descriptors) const {
+  Extract(Prepare(gray), ignore_mask, keypoints, descriptors);
+}
+
+void OrbExtractor::Extract(const OrbPyramid& pyramid, const cv::Mat& ignore_mask,
+                           std::vector<cv::KeyPoint>* keypoints, cv::Mat* descriptors) const {
+  DETSLAM_CHECK(keypoints != nullptr && descriptors != nullptr);
   if (!ignore_mask.empty() &&
-      (ignore_mask.type() != CV_8UC1 || ignore_mask.size() != gray.size())) {
+      (ignore_mask.type() != CV_8UC1 || ignore_mask.size() != pyramid.size)) {
     throw InputError("OrbExtractor::Extract: ignore_mask must be empty or CV_8UC1 of image size");
   }
   keypoints->clear();
@@ -253,44 +288,27 @@ void OrbExtractor::Extract(const cv::Mat& gray, const cv::Mat& ignore_mask,
   result.reserve(options_.num_features + 16);
   desc_rows.reserve(options_.num_features + 16);
 
-  cv::Mat level_image;  // the previous level, resized into the next
   std::vector<cv::KeyPoint> candidates;
-  for (int level = 0; level < options_.num_levels; ++level) {
+  for (size_t level = 0; level < pyramid.levels.size(); ++level) {
+    const OrbPyramid::Level& l = pyramid.levels[level];
     const double scale = scale_factors_[level];
-    const cv::Size size(static_cast<int>(std::lround(gray.cols * inv_scale_factors_[level])),
-                        static_cast<int>(std::lround(gray.rows * inv_scale_factors_[level])));
-    if (size.width <= 2 * kDetectBorder + 1 || size.height <= 2 * kDetectBorder + 1) break;
-    if (level == 0) {
-      level_image = gray;
-    } else {
-      cv::Mat resized;
-      cv::resize(level_image, resized, size, 0, 0, cv::INTER_LINEAR);
-      level_image = resized;
-    }
-    cv::Mat padded, blurred;
-    cv::copyMakeBorder(level_image, padded, kEdgeThreshold, kEdgeThreshold, kEdgeThreshold,
-                       kEdgeThreshold, cv::BORDER_REFLECT_101);
-
-    DetectCorners(level_image, scale, ignore_mask, options_, &candidates);
+    DetectCorners(l.image, scale, ignore_mask, options_, l.strong, &candidates);
 
     const std::vector<size_t> chosen = DistributeQuadtree(
-        candidates, kDetectBorder, static_cast<float>(size.width - kDetectBorder), kDetectBorder,
-        static_cast<float>(size.height - kDetectBorder), features_per_level_[level]);
-    if (chosen.empty()) continue;
-
-    cv::GaussianBlur(padded, blurred, cv::Size(7, 7), 2, 2, cv::BORDER_REFLECT_101);
+        candidates, kDetectBorder, static_cast<float>(l.image.cols - kDetectBorder), kDetectBorder,
+        static_cast<float>(l.image.rows - kDetectBorder), features_per_level_[level]);
     for (size_t i : chosen) {
       const cv::KeyPoint& c = candidates[i];
       const cv::Point center(static_cast<int>(std::lround(c.pt.x)) + kEdgeThreshold,
                              static_cast<int>(std::lround(c.pt.y)) + kEdgeThreshold);
       cv::KeyPoint kp;
-      kp.angle = CentroidAngle(padded, center, u_max);
+      kp.angle = CentroidAngle(l.padded, center, u_max);
       kp.response = c.response;
-      kp.octave = level;
+      kp.octave = static_cast<int>(level);
       kp.size = static_cast<float>(kPatchSize * scale);
       kp.pt = cv::Point2f(static_cast<float>(c.pt.x * scale), static_cast<float>(c.pt.y * scale));
       desc_rows.emplace_back();
-      ComputeDescriptor(blurred, center, kp.angle, desc_rows.back().data());
+      ComputeDescriptor(l.blurred, center, kp.angle, desc_rows.back().data());
       result.push_back(kp);
     }
   }

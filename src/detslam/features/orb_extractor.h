@@ -26,6 +26,20 @@ struct OrbOptions {
   bool Check(std::string* error) const;
 };
 
+// The part of OrbExtractor::Extract that needs no mask (OrbExtractor::Prepare): the image pyramid,
+// each level padded and blurred, and the FAST corners at the initial threshold over each level, so
+// that it can be computed while the frame's masks are still being made (camera-rate mode).
+struct OrbPyramid {
+  struct Level {
+    cv::Mat image;                     // the level
+    cv::Mat padded;                    // with the edge border (orientation)
+    cv::Mat blurred;                   // padded, Gaussian-blurred (descriptors)
+    std::vector<cv::KeyPoint> strong;  // FAST at ini_th_fast, level pixels
+  };
+  cv::Size size;  // level 0's
+  std::vector<Level> levels;
+};
+
 class OrbExtractor {
  public:
   // Throws InputError if the options do not pass Check().
@@ -37,6 +51,11 @@ class OrbExtractor {
   // response = FAST score, size = patch size (31) * level scale. descriptors: CV_8UC1, N x 32.
   // Throws InputError on a wrong image type or mask size. Deterministic.
   void Extract(const cv::Mat& gray, const cv::Mat& ignore_mask,
+               std::vector<cv::KeyPoint>* keypoints, cv::Mat* descriptors) const;
+  // The same in two steps: Prepare (no mask; throws InputError on a wrong image type), then
+  // Extract from its result (keypoints and descriptors identical to the one-step Extract's).
+  OrbPyramid Prepare(const cv::Mat& gray) const;
+  void Extract(const OrbPyramid& pyramid, const cv::Mat& ignore_mask,
                std::vector<cv::KeyPoint>* keypoints, cv::Mat* descriptors) const;
 
   int num_levels() const { return options_.num_levels; }

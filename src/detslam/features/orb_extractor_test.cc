@@ -224,6 +224,37 @@ TEST(OrbExtractorTest, SkippingMaskedCellsDoesNotChangeTheResult) {
   EXPECT_GT(Extract(image, masks[0]).keypoints.size(), 500u);  // the test extracts something
 }
 
+// Prepare once (no mask), then Extract from the prepared pyramid with different masks: each gives
+// the one-step Extract's keypoints and descriptors, and the pyramid is not changed by its use.
+TEST(OrbExtractorTest, PreparedPyramidGivesTheOneStepResultForAnyMask) {
+  const cv::Mat image = MakeTexture(640, 480, 12);
+  cv::Mat blob(480, 640, CV_8UC1, cv::Scalar(0));
+  cv::ellipse(blob, {300, 240}, {120, 220}, 0, 0, 360, cv::Scalar(255), cv::FILLED);
+  const OrbExtractor extractor{OrbOptions()};
+  const OrbPyramid pyramid = extractor.Prepare(image);
+  ASSERT_EQ(pyramid.levels.size(), 8u);
+  for (const cv::Mat& mask : {cv::Mat(), blob, cv::Mat()}) {
+    std::vector<cv::KeyPoint> one, two;
+    cv::Mat one_desc, two_desc;
+    extractor.Extract(image, mask, &one, &one_desc);
+    extractor.Extract(pyramid, mask, &two, &two_desc);
+    ASSERT_EQ(one.size(), two.size());
+    ASSERT_GT(one.size(), 500u);
+    for (size_t i = 0; i < one.size(); ++i) {
+      EXPECT_EQ(one[i].pt, two[i].pt) << i;
+      EXPECT_EQ(one[i].octave, two[i].octave) << i;
+      EXPECT_EQ(one[i].angle, two[i].angle) << i;
+      EXPECT_EQ(one[i].response, two[i].response) << i;
+    }
+    EXPECT_EQ(cv::norm(one_desc, two_desc, cv::NORM_HAMMING), 0.0);
+  }
+  std::vector<cv::KeyPoint> kps;
+  cv::Mat desc;
+  EXPECT_THROW(extractor.Extract(pyramid, cv::Mat(240, 320, CV_8UC1, cv::Scalar(0)), &kps, &desc),
+               InputError);
+  EXPECT_THROW(extractor.Prepare(cv::Mat(480, 640, CV_32F, cv::Scalar(0))), InputError);
+}
+
 TEST(OrbExtractorTest, RotatingImageRotatesKeypointAngles) {
   const cv::Mat image = MakeTexture(640, 480, 4);
   for (double theta : {25.0, -70.0, 150.0}) {

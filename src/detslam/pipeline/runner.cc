@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <future>
 #include <mutex>
 #include <numeric>
 #include <optional>
@@ -463,15 +464,22 @@ class SimulatedAsyncSegmentation {
   std::vector<double> detection_ms_;
 };
 
+// `pyramid`: null, or slam.PrepareExtraction of the frame's image.
 Frame Extract(const SlamSystem& slam, const RgbdSource& dataset, const LoadedFrame& f,
-              FrameReport* report) {
+              FrameReport* report, const OrbPyramid* pyramid = nullptr) {
   report->segmentation_ms = f.segmentation_ms;
   report->mask_source = f.mask_source;
   report->mask_age = f.mask_age;
   return slam.ExtractFrame(f.index, dataset.stamp(static_cast<size_t>(f.index)), f.images.gray,
                            f.images.depth_m, cv::Mat(), report,
-                           f.segmented ? &f.instances : nullptr);
+                           f.segmented ? &f.instances : nullptr, pyramid);
 }
+
+// SlamSystem::PrepareExtraction with its time.
+struct PreparedExtraction {
+  OrbPyramid pyramid;
+  double ms = 0;
+};
 
 }  // namespace
 
@@ -662,12 +670,31 @@ RunSummary RunThreaded(const RgbdSource& dataset, const Settings& settings,
       [&] {
         while (std::optional<LoadedFrame> f = extraction_input.Pop()) {
           if (StopRequested(options)) break;
-          if (async && f->unreadable.empty() && !carry_masks(&*f)) continue;
+          // The mask-free part of the extraction in a helper thread while the masks are carried
+          // (RunOptions::parallel_extraction); it only reads the image, which outlives it.
+          std::future<PreparedExtraction> prepared;
+          if (async && options.parallel_extraction && f->unreadable.empty()) {
+            prepared = std::async(std::launch::async, [&slam, &gray = f->images.gray] {
+              const auto t0 = std::chrono::steady_clock::now();
+              PreparedExtraction p{slam.PrepareExtraction(gray), 0.0};
+              p.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0)
+                         .count();
+              return p;
+            });
+          }
+          if (async && f->unreadable.empty() && !carry_masks(&*f)) {
+            if (prepared.valid()) prepared.wait();
+            continue;
+          }
           Extracted e;
           if (!f->unreadable.empty()) {
             e.report = SkippedReport(dataset, *f);
           } else {
-            e.frame = Extract(slam, dataset, *f, &e.report);
+            std::optional<PreparedExtraction> p;
+            if (prepared.valid()) p = prepared.get();
+            e.frame = Extract(slam, dataset, *f, &e.report, p ? &p->pyramid : nullptr);
+            // The helper's part (alongside the carrying) counts as extraction time too.
+            if (p) e.report.timings.extraction_ms += p->ms;
             e.instances = std::move(f->instances);
             e.segmented = f->segmented;
             e.depth_m = f->images.depth_m;

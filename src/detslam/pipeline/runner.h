@@ -47,6 +47,11 @@ struct RunOptions {
   // and tracking starts with the next frame, its masks carried from the first. Chosen on the
   // tuning seeds (README, Options).
   bool first_frame_waits_for_masks = true;
+  // Asynchronous segmentation: the part of a frame's feature extraction that needs no masks (image
+  // pyramid, blurred levels, strong FAST corners; SlamSystem::PrepareExtraction) runs in a helper
+  // thread while the frame's masks are carried to it, so that a frame's pose comes sooner. The
+  // keypoints are the same either way.
+  bool parallel_extraction = true;
   // Sequential mode with a segmenter: the asynchronous segmentation above, simulated so that it is
   // deterministic: the detector takes this many input frames for each frame it segments (it starts
   // on the newest frame whenever it is free, and its masks are published before the frame that

@@ -311,9 +311,11 @@ FrameInstances SlamSystem::DetectFrame(const SegmenterInput& input) {
 
 Frame SlamSystem::ExtractFrame(int64_t index, Timestamp stamp, const cv::Mat& gray,
                                const cv::Mat& depth_m, const cv::Mat& ignore_mask,
-                               FrameReport* report, const std::vector<Instance>* instances) const {
+                               FrameReport* report, const std::vector<Instance>* instances,
+                               const OrbPyramid* pyramid) const {
   const auto t0 = std::chrono::steady_clock::now();
-  LabelledKeypoints all = dynamic_.Extract(extractor_, gray, depth_m, ignore_mask, instances);
+  LabelledKeypoints all =
+      dynamic_.Extract(extractor_, gray, depth_m, ignore_mask, instances, pyramid);
   report->dynamic_instances = all.instances_used;
   // Static keypoints go to tracking; the others stay in the frame for diagnostics only.
   std::vector<cv::KeyPoint> kept, rejected;

@@ -179,10 +179,15 @@ class SlamSystem {
   // Feature extraction stage: thread-safe (const), may run ahead of tracking in another thread.
   // With `instances` (from SegmentFrame), the Det-SLAM stage labels keypoints on dynamic objects:
   // they are moved to the frame's rejected list (labelled) and never reach tracking. Fills
-  // report->timings.extraction_ms, num_keypoints and the dynamic counters.
+  // report->timings.extraction_ms, num_keypoints and the dynamic counters. `pyramid`: null, or
+  // PrepareExtraction(gray) computed earlier (e.g. in another thread while the frame's masks were
+  // carried to it; its time is not in extraction_ms then); the result is the same.
   Frame ExtractFrame(int64_t index, Timestamp stamp, const cv::Mat& gray, const cv::Mat& depth_m,
                      const cv::Mat& ignore_mask, FrameReport* report,
-                     const std::vector<Instance>* instances = nullptr) const;
+                     const std::vector<Instance>* instances = nullptr,
+                     const OrbPyramid* pyramid = nullptr) const;
+  // The part of ExtractFrame that needs no masks (OrbExtractor::Prepare); thread-safe (const).
+  OrbPyramid PrepareExtraction(const cv::Mat& gray) const { return extractor_.Prepare(gray); }
   // Tracking stage: tracks an extracted frame (input order) and makes it a keyframe when the
   // tracker asks for one. Returns the new keyframe for MapKeyFrame, or kNoKeyFrame. With
   // `tracked`, the frame as tracked (its keypoints' landmarks, outliers and labels) is moved there
