@@ -536,6 +536,7 @@ RunSummary RunThreaded(const RgbdSource& dataset, const Settings& settings,
   const OpenCvThreads cv_threads(options.realtime ? options.camera_rate_opencv_threads : 0);
   // Asynchronous segmentation: the newest frame for the segmentation thread, and its results.
   const bool async = options.realtime && options.async_segmentation && segmenter != nullptr;
+  const int mapping_nice = options.mapping_nice >= 0 ? options.mapping_nice : options.background_nice;
   SlamOptions slam_options = async ? CameraRateMasks(options) : options.slam;
   slam_options.global_ba_thread = options.mapping_thread;  // nothing waits for it then
   slam_options.loop_thread = options.mapping_thread && options.loop_thread;
@@ -712,7 +713,7 @@ RunSummary RunThreaded(const RgbdSource& dataset, const Settings& settings,
     stages.Start(
         "local mapping",
         [&] {
-          if (options.realtime) LowerThisThreadPriority(options.background_nice);
+          if (options.realtime) LowerThisThreadPriority(mapping_nice);
           while (std::optional<KeyFrameId> kf = keyframes.Pop()) {
             if (StopRequested(options)) break;  // the keyframe stays in the map, not locally mapped
             FrameReport unused;
@@ -726,7 +727,7 @@ RunSummary RunThreaded(const RgbdSource& dataset, const Settings& settings,
     stages.Start(
         "loop closing",
         [&] {
-          if (options.realtime) LowerThisThreadPriority(options.background_nice);
+          if (options.realtime) LowerThisThreadPriority(mapping_nice);
           while (std::optional<KeyFrameId> kf = to_close.Pop()) {
             if (StopRequested(options)) break;
             FrameReport unused;

@@ -75,6 +75,10 @@ struct RunOptions {
   // that when the cores are busy the frames' path (camera, extraction, tracking) gets them first.
   // 5 was chosen on walking_xyz tuning seeds 1-3 (docs/BENCHMARKS.md, section realtime).
   int background_nice = 5;
+  // Camera-rate mode: the nice value of the local-mapping and loop-closing threads (and the global
+  // bundle adjustment they start); -1: background_nice. They hold the map's lock in short steps,
+  // and a step of a thread the scheduler puts behind the frames' path holds tracking up longer.
+  int mapping_nice = -1;
   // Camera-rate mode: OpenCV's threads during the run (cv::setNumThreads, process-wide; restored
   // after it); 0 keeps OpenCV's default (one per core). Mostly the detector's network uses them:
   // with 1 it runs in the segmentation thread alone, at that thread's lower priority, instead of
