@@ -166,6 +166,7 @@ void DetectCorners(const cv::Mat& level_image, double scale, const cv::Mat& igno
   }
 
   // Cells without any: retry at the low threshold, on the cell grown by the FAST radius.
+  std::vector<cv::KeyPoint> found;
   for (int cy = 0; cy < rows; ++cy) {
     for (int cx = 0; cx < cols; ++cx) {
       if (cell_has_corner[cy * cols + cx]) continue;
@@ -180,7 +181,7 @@ void DetectCorners(const cv::Mat& level_image, double scale, const cv::Mat& igno
       }
       const cv::Rect roi(x_begin - kFastRadius, y_begin - kFastRadius,
                          x_end - x_begin + 2 * kFastRadius, y_end - y_begin + 2 * kFastRadius);
-      std::vector<cv::KeyPoint> found;
+      found.clear();
       cv::FAST(level_image(roi), found, options.min_th_fast, true);
       for (cv::KeyPoint& kp : found) {
         kp.pt.x += roi.x;
