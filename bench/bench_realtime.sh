@@ -2,11 +2,13 @@
 # Camera-rate benchmark (issue: real time on two CPU cores). Every row is a synthetic sequence from
 # `detslam synth` (people from the real TUM cut-outs in ../shared), default dnn segmenter, seed 42.
 # Per walking preset and evaluation seed (SEEDS; nothing in the camera-rate mode was chosen on any
-# seed), two runs of the same frames:
-#   offline   sequential, every frame segmented (the accuracy reference)
+# seed), runs of the same frames:
+#   offline   sequential, every frame segmented (the accuracy reference; deterministic)
 #   live      `detslam run --realtime`: frames offered at their timestamps (30 fps), dropped when
 #             the pipeline is busy; threaded with the mapping and loop-closing threads;
-#             asynchronous segmentation
+#             asynchronous segmentation. LIVE_REPEATS runs (default 3): a live run depends on the
+#             scheduler, and one run's ATE and latency tail spread widely, so each sequence's
+#             figures are the mean over its runs, with the worst single run beside it
 #   sync      the same with --sync-segmentation (each frame taken is segmented before extraction:
 #             the previous design, for comparison)
 # and reports, from the live run's own outputs (run.json and its trajectory, not a replay): frames
@@ -27,7 +29,8 @@
 # docs/realtime_long.svg; writes section realtime-long.
 # Usage: bench/bench_realtime.sh [path/to/detslam]
 #   (env: PRESETS="walking_xyz walking_static walking_rpy walking_halfsphere", SEEDS="101 102 103",
-#    FRAMES=300, PARTS="live tracking", REPEATS=5, LONG_FRAMES=20000, LONG_SEED=101)
+#    FRAMES=300, PARTS="live tracking", LIVE_REPEATS=3, REPEATS=5, LONG_FRAMES=20000,
+#    LONG_SEED=101)
 set -euo pipefail
 # The synthetic sensor model (`detslam synth --realism`): realistic, the generator's default;
 # REALISM=easy gives the first generator's sequences.
@@ -39,9 +42,10 @@ presets="${PRESETS:-walking_xyz walking_static walking_rpy walking_halfsphere}"
 seeds="${SEEDS:-101 102 103}"
 frames="${FRAMES:-300}"
 parts="${PARTS:-live tracking}"
+live_repeats="${LIVE_REPEATS:-3}"
 long_frames="${LONG_FRAMES:-20000}"
 long_seed="${LONG_SEED:-101}"
-settings_line="bench/bench_realtime.sh (PRESETS=\"$presets\" SEEDS=\"$seeds\" FRAMES=$frames PARTS=\"$parts\"$([[ " $parts " != *" long "* ]] || echo " LONG_FRAMES=$long_frames LONG_SEED=$long_seed") REALISM=$realism)"
+settings_line="bench/bench_realtime.sh (PRESETS=\"$presets\" SEEDS=\"$seeds\" FRAMES=$frames PARTS=\"$parts\" LIVE_REPEATS=$live_repeats$([[ " $parts " != *" long "* ]] || echo " LONG_FRAMES=$long_frames LONG_SEED=$long_seed") REALISM=$realism)"
 work="$(mktemp -d)"
 trap 'rm -rf "$work"' EXIT
 bench_name=bench_realtime
@@ -59,24 +63,30 @@ for preset in $presets; do
     "$bin" synth --realism "$realism" --preset "$preset" --seed "$seed" --frames "$frames" --people "$people" --out "$seq" >/dev/null 2>&1
     progress "$preset seed $seed: offline (sequential)"
     run_eval "$seq" "$seq.offline" --segmenter dnn --models "$models"
-    progress "$preset seed $seed: live (--realtime)"
-    run_eval "$seq" "$seq.live" --segmenter dnn --models "$models" --realtime
+    for rep in $(seq 1 "$live_repeats"); do
+      progress "$preset seed $seed: live (--realtime), run $rep of $live_repeats"
+      run_eval "$seq" "$seq.live$rep" --segmenter dnn --models "$models" --realtime
+    done
     progress "$preset seed $seed: live (--realtime --sync-segmentation)"
     run_eval "$seq" "$seq.sync" --segmenter dnn --models "$models" --realtime --sync-segmentation
-    python3 - "$seq" "$preset" "$seed" >>"$rows" <<'PY'
+    python3 - "$seq" "$preset" "$seed" "$live_repeats" >>"$rows" <<'PY'
 import json, sys
-seq, preset, seed = sys.argv[1:4]
-live = json.load(open(seq + ".live/run.json"))
-t = live["realtime"]
+seq, preset, seed, repeats = sys.argv[1:5]
 ate = lambda p: json.load(open(p + "/eval.json"))["ate"]["rmse"]
-print(json.dumps({"preset": preset, "seed": int(seed), "offered": t["offered"], "dropped": t["dropped"],
-                  "processed": live["frames"], "tracked": live["frames_tracked"],
-                  "fps": t["processed_fps"], "lat_median": t["latency_ms"]["median"],
-                  "lat_p99": t["latency_ms"]["p99"], "ate_live": ate(seq + ".live"),
-                  "ate_offline": ate(seq + ".offline"), "segmented": t["frames_segmented"],
-                  "age_median": t["mask_age_frames"]["median"], "age_max": t["mask_age_frames"]["max"],
-                  "deferred": t["keyframes_deferred"], "keyframes": live["keyframes"],
-                  "burst": t.get("keyframes_mapped_in_burst", -1),
+runs = []  # one per live run, in run order
+for k in range(1, int(repeats) + 1):
+    live = json.load(open(f"{seq}.live{k}/run.json"))
+    t = live["realtime"]
+    runs.append({"offered": t["offered"], "dropped": t["dropped"],
+                 "processed": live["frames"], "tracked": live["frames_tracked"],
+                 "fps": t["processed_fps"], "lat_median": t["latency_ms"]["median"],
+                 "lat_p99": t["latency_ms"]["p99"], "ate_live": ate(f"{seq}.live{k}"),
+                 "segmented": t["frames_segmented"],
+                 "age_median": t["mask_age_frames"]["median"], "age_max": t["mask_age_frames"]["max"],
+                 "deferred": t["keyframes_deferred"], "keyframes": live["keyframes"],
+                 "burst": t.get("keyframes_mapped_in_burst", -1)})
+print(json.dumps({"preset": preset, "seed": int(seed), "runs": runs,
+                  "ate_offline": ate(seq + ".offline"),
                   "sync_fps": json.load(open(seq + ".sync/run.json"))["realtime"]["processed_fps"],
                   "ate_sync": ate(seq + ".sync")}))
 PY
@@ -120,38 +130,69 @@ print(f"`detslam run --realtime` on synthetic walking sequences (people from the
       "reads the issue's \"at least 30 fps processed (at most 2 % of frames dropped)\" as processed fps "
       "at least 98 % of the camera's 30 fps: frames offered at 30 fps give 30.0 processed fps only "
       "when not one frame is dropped.\n")
-print("| preset | seed | processed fps | dropped | latency median ms | latency p99 ms | frames segmented | mask age median / max | keyframes (deferred, burst) | processed frames tracked | ATE live mm | ATE offline mm | ATE ratio | sync fps | sync ATE ratio |")
+n_runs = len(rows[0]["runs"])
+mean = statistics.fmean
+for r in rows:  # per sequence: the mean over its live runs and the worst single run
+    for run in r["runs"]:
+        run["drop_pct"] = 100 * run["dropped"] / run["offered"]
+        run["ratio"] = run["ate_live"] / r["ate_offline"]
+    r["m"] = {k: mean(run[k] for run in r["runs"]) for k in
+              ("fps", "drop_pct", "lat_median", "lat_p99", "ate_live", "ratio", "segmented",
+               "age_median", "keyframes", "deferred", "burst")}
+    r["worst"] = {"fps": min(run["fps"] for run in r["runs"]),
+                  "drop_pct": max(run["drop_pct"] for run in r["runs"]),
+                  "lat_p99": max(run["lat_p99"] for run in r["runs"]),
+                  "ate_live": max(run["ate_live"] for run in r["runs"]),
+                  "ratio": max(run["ratio"] for run in r["runs"]),
+                  "age_max": max(run["age_max"] for run in r["runs"])}
+print(f"Each sequence ran live {n_runs} times (LIVE_REPEATS): a live run depends on the scheduler, and "
+      "one run's ATE and latency tail spread widely between runs of the same frames. Each row gives the "
+      "mean over its live runs and, in brackets, the worst single run; the targets are checked on each "
+      "sequence's mean (what a user gets on average) and the worst single run is printed beside each. "
+      "Runs of this section before 2026-12-07 06:00 made one live run per sequence.\n")
+print("| preset | seed | processed fps | dropped % | latency median ms | latency p99 ms | frames segmented | mask age median / max | keyframes (deferred, burst) | processed frames tracked | ATE live mm | ATE offline mm | ATE ratio | sync fps | sync ATE ratio |")
 print("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")
 for r in rows:
-    print(f'| {r["preset"]} | {r["seed"]} | {r["fps"]:.1f} | {r["dropped"]}/{r["offered"]} '
-          f'({100 * r["dropped"] / r["offered"]:.1f} %) | {r["lat_median"]:.0f} | {r["lat_p99"]:.0f} | '
-          f'{r["segmented"]} | {r["age_median"]:.0f} / {r["age_max"]:.0f} | {r["keyframes"]} ({r["deferred"]}, {r["burst"]}) | '
-          f'{r["tracked"]}/{r["processed"]} | {1000 * r["ate_live"]:.1f} | {1000 * r["ate_offline"]:.1f} | '
-          f'{r["ate_live"] / r["ate_offline"]:.2f} | {r["sync_fps"]:.1f} | {r["ate_sync"] / r["ate_offline"]:.2f} |')
+    m, w = r["m"], r["worst"]
+    tracked = sum(run["tracked"] for run in r["runs"])
+    processed = sum(run["processed"] for run in r["runs"])
+    print(f'| {r["preset"]} | {r["seed"]} | {m["fps"]:.1f} ({w["fps"]:.1f}) | {m["drop_pct"]:.1f} ({w["drop_pct"]:.1f}) | '
+          f'{m["lat_median"]:.0f} | {m["lat_p99"]:.0f} ({w["lat_p99"]:.0f}) | {m["segmented"]:.0f} | '
+          f'{m["age_median"]:.1f} / {w["age_max"]:.0f} | {m["keyframes"]:.0f} ({m["deferred"]:.0f}, {m["burst"]:.0f}) | '
+          f'{tracked}/{processed} | {1000 * m["ate_live"]:.1f} ({1000 * w["ate_live"]:.1f}) | {1000 * r["ate_offline"]:.1f} | '
+          f'{m["ratio"]:.2f} ({w["ratio"]:.2f}) | {r["sync_fps"]:.1f} | {r["ate_sync"] / r["ate_offline"]:.2f} |')
 def agg(key):
     v = [key(r) for r in rows]
     return statistics.fmean(v), (statistics.pstdev(v) if len(v) > 1 else 0.0), v
-fps_m, fps_sd, fps = agg(lambda r: r["fps"])
-drop_m, drop_sd, drop = agg(lambda r: 100 * r["dropped"] / r["offered"])
-p99_m, p99_sd, p99 = agg(lambda r: r["lat_p99"])
-ratio_m, ratio_sd, ratio = agg(lambda r: r["ate_live"] / r["ate_offline"])
+all_runs = [run for r in rows for run in r["runs"]]
+fps_m, fps_sd, fps = agg(lambda r: r["m"]["fps"])
+drop_m, drop_sd, drop = agg(lambda r: r["m"]["drop_pct"])
+p99_m, p99_sd, p99 = agg(lambda r: r["m"]["lat_p99"])
+ratio_m, ratio_sd, ratio = agg(lambda r: r["m"]["ratio"])
 sfps_m, sfps_sd, sfps = agg(lambda r: r["sync_fps"])
 sratio_m, sratio_sd, sratio = agg(lambda r: r["ate_sync"] / r["ate_offline"])
-untracked = sum(r["processed"] - r["tracked"] for r in rows)
-print(f"\nOver the {len(rows)} sequences (mean, sd, worst): processed {fps_m:.1f} fps (sd {fps_sd:.1f}, "
+untracked = sum(run["processed"] - run["tracked"] for run in all_runs)
+print(f"\nOver the {len(rows)} sequences' means (mean, sd, worst sequence): processed {fps_m:.1f} fps (sd {fps_sd:.1f}, "
       f"worst {min(fps):.1f}); dropped {drop_m:.1f} % (sd {drop_sd:.1f}, worst {max(drop):.1f}); latency p99 "
       f"{p99_m:.0f} ms (sd {p99_sd:.0f}, worst {max(p99):.0f}); ATE ratio {ratio_m:.2f} (sd {ratio_sd:.2f}, "
-      f"worst {max(ratio):.2f}); processed frames without a pose: {untracked}. With --sync-segmentation: "
+      f"worst {max(ratio):.2f}); processed frames without a pose in all {len(all_runs)} runs: {untracked}. "
+      f"With --sync-segmentation (one run per sequence): "
       f"{sfps_m:.1f} fps (worst {min(sfps):.1f}), ATE ratio {sratio_m:.2f} (worst {max(sratio):.2f}).\n")
 def target(name, ok, detail):
     print(f"- {name}: {'met' if ok else 'MISSED'} ({detail})")
-print("Targets of the issue, per sequence:")
+def single(key, ok, worst):
+    v = [key(run) for run in all_runs]
+    return f"single runs: {sum(ok(x) for x in v)} of {len(v)} within, worst {worst(v)}"
+print("Targets of the issue, on each sequence's mean over its live runs:")
 target("at least 30 fps processed (98 % of the camera's 30 fps: 29.4)", min(fps) >= 29.4,
-       f"worst {min(fps):.1f}")
-target("at most 2 % of frames dropped", max(drop) <= 2, f"worst {max(drop):.1f} %")
-target("pose latency p99 at most 60 ms", max(p99) <= 60, f"worst {max(p99):.0f} ms")
-target("live ATE within 10 % of the offline run's", max(ratio) <= 1.10, f"worst ratio {max(ratio):.2f}")
-target("every processed frame tracked", untracked == 0, f"{untracked} without a pose")
+       f"worst sequence {min(fps):.1f}; " + single(lambda x: x["fps"], lambda x: x >= 29.4, lambda v: f"{min(v):.1f}"))
+target("at most 2 % of frames dropped", max(drop) <= 2,
+       f"worst sequence {max(drop):.1f} %; " + single(lambda x: x["drop_pct"], lambda x: x <= 2, lambda v: f"{max(v):.1f} %"))
+target("pose latency p99 at most 60 ms", max(p99) <= 60,
+       f"worst sequence {max(p99):.0f} ms; " + single(lambda x: x["lat_p99"], lambda x: x <= 60, lambda v: f"{max(v):.0f} ms"))
+target("live ATE within 10 % of the offline run's", max(ratio) <= 1.10,
+       f"worst sequence {max(ratio):.2f}; " + single(lambda x: x["ratio"], lambda x: x <= 1.10, lambda v: f"{max(v):.2f}"))
+target("every processed frame tracked (every run)", untracked == 0, f"{untracked} without a pose")
 PY
 publish realtime "$work/section.md"
 fi

@@ -165,14 +165,18 @@ def summary(bench_text):
                          f"scene {r['median distance mm']} mm"))
     realtime = section(bench_text, "realtime")
     if realtime:
-        m = re.search(r"Over the (\d+) sequences \(mean, sd, worst\): processed ([0-9.]+) fps \(sd [0-9.]+, "
+        # Since 2026-12-07 each sequence's figures are the mean over several live runs
+        # (LIVE_REPEATS); the older one-run sections read the same way.
+        m = re.search(r"Over the (\d+) sequences(?:' means)? \(mean, sd, worst(?: sequence)?\): processed "
+                      r"([0-9.]+) fps \(sd [0-9.]+, "
                       r"worst ([0-9.]+)\); dropped ([0-9.]+) % \(sd [0-9.]+, worst ([0-9.]+)\); latency p99 "
                       r"([0-9.]+) ms \(sd [0-9.]+, worst ([0-9.]+)\); ATE ratio ([0-9.]+) \(sd [0-9.]+, "
-                      r"worst ([0-9.]+)\); processed frames without a pose: (\d+)", realtime)
+                      r"worst ([0-9.]+)\); processed frames without a pose(?: in all (\d+) runs)?: (\d+)", realtime)
         if m:
-            n, fps, fps_w, drop, drop_w, p99, p99_w, ratio, ratio_w, untracked = m.groups()
+            n, fps, fps_w, drop, drop_w, p99, p99_w, ratio, ratio_w, runs, untracked = m.groups()
+            runs_text = f", {int(runs) // int(n)} live runs each, their mean" if runs else ""
             rows.append((f"Camera rate (`--realtime`, asynchronous dnn segmentation; synthetic walking "
-                         f"presets, {n} sequences of evaluation seeds)",
+                         f"presets, {n} sequences of evaluation seeds{runs_text})",
                          f"{fps} fps processed (worst {fps_w}), {drop} % dropped (worst {drop_w} %), "
                          f"latency p99 {p99} ms (worst {p99_w}); {untracked} processed frames without a pose",
                          f"live ATE {ratio}x the offline run's (worst {ratio_w}x)"))

@@ -73,7 +73,8 @@ struct RunOptions {
   // Camera-rate mode: the asynchronous segmentation thread and the local-mapping thread (and the
   // global bundle adjustment it starts) run at this nice value (Linux; 0 = the frame path's), so
   // that when the cores are busy the frames' path (camera, extraction, tracking) gets them first.
-  // 5 was chosen on walking_xyz tuning seeds 1-3 (docs/BENCHMARKS.md, section realtime).
+  // 5 was chosen on walking_xyz tuning seeds 1-3 (docs/BENCHMARKS.md, section realtime); key
+  // Segmentation.CameraRateNice.
   int background_nice = 5;
   // Camera-rate mode: the nice value of the local-mapping and loop-closing threads (and the global
   // bundle adjustment they start); -1: background_nice. They hold the map's lock in short steps,
