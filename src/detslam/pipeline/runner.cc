@@ -601,7 +601,9 @@ RunSummary RunThreaded(const RgbdSource& dataset, const Settings& settings,
     stages.Start(
         "segmentation",
         [&] {
-          LowerThisThreadPriority(options.background_nice);  // async segmentation runs only at camera rate
+          // Asynchronous segmentation runs only at camera rate.
+          if (!options.idle_segmentation || !MakeThisThreadIdlePriority())
+            LowerThisThreadPriority(options.background_nice);
           while (std::optional<LoadedFrame> f = to_segment.Pop()) {
             if (StopRequested(options)) break;
             FrameInstances d = slam.DetectFrame(SegmentationInput(dataset, *f));

@@ -80,6 +80,9 @@ struct RunOptions {
   // bundle adjustment they start); -1: background_nice. They hold the map's lock in short steps,
   // and a step of a thread the scheduler puts behind the frames' path holds tracking up longer.
   int mapping_nice = -1;
+  // Camera-rate mode: the asynchronous segmentation thread under SCHED_IDLE
+  // (MakeThisThreadIdlePriority) instead of background_nice.
+  bool idle_segmentation = false;
   // Camera-rate mode: OpenCV's threads during the run (cv::setNumThreads, process-wide; restored
   // after it); 0 keeps OpenCV's default (one per core). Mostly the detector's network uses them:
   // with 1 it runs in the segmentation thread alone, at that thread's lower priority, instead of

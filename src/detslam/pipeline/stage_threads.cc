@@ -1,6 +1,8 @@
 #include "detslam/pipeline/stage_threads.h"
 
 #if defined(__linux__)
+#include <pthread.h>
+#include <sched.h>
 #include <sys/resource.h>
 #include <sys/syscall.h>
 #include <unistd.h>
@@ -16,6 +18,16 @@ bool LowerThisThreadPriority(int nice) {
   return setpriority(PRIO_PROCESS, tid, nice) == 0;
 #else
   (void)nice;
+  return false;
+#endif
+}
+
+bool MakeThisThreadIdlePriority() {
+#if defined(__linux__)
+  sched_param param{};
+  param.sched_priority = 0;
+  return pthread_setschedparam(pthread_self(), SCHED_IDLE, &param) == 0;
+#else
   return false;
 #endif
 }

@@ -18,6 +18,12 @@ namespace detslam {
 // it starts later inherit it). Returns false where that is not possible (then nothing changes).
 bool LowerThisThreadPriority(int nice);
 
+// Puts the calling thread under Linux's SCHED_IDLE policy: it runs only on a core no other
+// (normal-policy) thread of the machine wants, and a normal thread that wakes takes its core at
+// once (with a nice value it would wait for the scheduler's granularity). Threads it starts later
+// inherit it. Returns false where that is not possible (then nothing changes).
+bool MakeThisThreadIdlePriority();
+
 class StageThreads {
  public:
   explicit StageThreads(std::function<void()> stop);
