@@ -7,6 +7,8 @@
 #include <thread>
 
 #if defined(__linux__)
+#include <pthread.h>
+#include <sched.h>
 #include <sys/resource.h>
 #include <sys/syscall.h>
 #include <unistd.h>
@@ -94,6 +96,29 @@ TEST(StageThreads, LowerThisThreadPriorityChangesTheCallingThreadOnly) {
   EXPECT_EQ(lowered, before + 3);
   EXPECT_EQ(child, before + 3);
   EXPECT_EQ(nice_of_this_thread(), before);
+}
+
+// SCHED_IDLE for the calling thread only, inherited by the threads it starts.
+TEST(StageThreads, MakeThisThreadIdlePriorityChangesTheCallingThreadOnly) {
+  const auto policy_of_this_thread = [] {
+    int policy = -1;
+    sched_param param{};
+    pthread_getschedparam(pthread_self(), &policy, &param);
+    return policy;
+  };
+  const int before = policy_of_this_thread();
+  ASSERT_NE(before, SCHED_IDLE);
+  int idle = -1, child = -1;
+  std::thread t([&] {
+    ASSERT_TRUE(MakeThisThreadIdlePriority());
+    idle = policy_of_this_thread();
+    std::thread grandchild([&] { child = policy_of_this_thread(); });
+    grandchild.join();
+  });
+  t.join();
+  EXPECT_EQ(idle, SCHED_IDLE);
+  EXPECT_EQ(child, SCHED_IDLE);
+  EXPECT_EQ(policy_of_this_thread(), before);
 }
 #endif
 
