@@ -40,6 +40,7 @@ bool MoverCheckOptions::Check(std::string* error) const {
   if (!(region_growth_px >= 0)) message = "region_growth_px must be non-negative";
   if (!(region_depth_ratio >= 0 && region_depth_ratio < 1))
     message = "region_depth_ratio must be in [0, 1)";
+  if (!(coherence >= 0)) message = "coherence must be non-negative";
   if (error != nullptr) *error = message;
   return message.empty();
 }

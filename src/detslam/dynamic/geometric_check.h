@@ -44,6 +44,12 @@ struct MoverCheckOptions {
   int region_min_keypoints = 4;
   double region_growth_px = 10.0;
   double region_depth_ratio = 0.1;
+  // A neighbour confirms a candidate only when their residual vectors (observed minus projected
+  // position) agree: differ by at most this fraction of the longer one. A moving object shifts
+  // its keypoints alike; the associations the pose optimiser rejected on a static scene
+  // (mismatches) point every way, and they cluster where the texture is dense. 0: off (any
+  // flagged neighbour at the same depth confirms).
+  double coherence = 0.0;
 
   bool Check(std::string* error) const;
 };

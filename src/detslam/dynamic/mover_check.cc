@@ -43,30 +43,36 @@ int LabelMovers(const PinholeCamera& camera, const ScaleInfo& scale,
   const Rigid3d& pose = *frame.cam_from_world;
   // 1. Residuals of every associated keypoint at the optimised pose.
   std::vector<double> residual(n, -1.0);
+  std::vector<Eigen::Vector2d> offset(n, Eigen::Vector2d::Zero());  // observed - projected, pixels
   for (size_t i = 0; i < n; ++i) {
     if (!points[i]) continue;
     const Eigen::Vector3d pc = pose * *points[i];
     if (pc.z() <= 0) continue;
-    const Eigen::Vector2d uv = camera.Project(pc);
-    residual[i] =
-        (uv - f.undist[i]).norm() / scale.scale_factors[static_cast<size_t>(f.keypoints[i].octave)];
+    offset[i] = f.undist[i] - camera.Project(pc);
+    residual[i] = offset[i].norm() / scale.scale_factors[static_cast<size_t>(f.keypoints[i].octave)];
   }
   std::vector<KeypointLabel> candidate = *labels;
   const GeometricCheckResult stats = FlagGeometricOutliers(residual, options.threshold, &candidate);
 
   // 2. Confirm candidates by flagged neighbours at the same depth (candidates of this call only:
-  //    keypoints labelled before it, e.g. in a mover region, are not evidence).
+  //    keypoints labelled before it, e.g. in a mover region, are not evidence) that moved alike
+  //    (options.coherence).
   const double radius = options.radius_px;
   const auto flagged = [&](size_t i) {
     return candidate[i] == KeypointLabel::kGeometric && (*labels)[i] == KeypointLabel::kStatic;
+  };
+  const auto alike = [&](size_t i, size_t j) {
+    if (options.coherence <= 0) return true;
+    return (offset[i] - offset[j]).norm() <=
+           options.coherence * std::max(offset[i].norm(), offset[j].norm());
   };
   std::vector<size_t> seeds;
   for (size_t i = 0; i < n; ++i) {
     if (!flagged(i)) continue;
     int neighbours = 0;
     for (size_t j : f.grid->FeaturesInArea(f.undist[i].x(), f.undist[i].y(), radius)) {
-      if (j != i && flagged(j) &&
-          SameDepth(f.depth[i], f.depth[j], options.depth_ratio)) {
+      if (j != i && flagged(j) && SameDepth(f.depth[i], f.depth[j], options.depth_ratio) &&
+          alike(i, j)) {
         ++neighbours;
       }
     }

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <array>
+#include <cmath>
 
 namespace detslam {
 namespace {
@@ -84,6 +85,37 @@ TEST(LabelMovers, NeedsEnoughFlaggedNeighboursAndKeepsOtherLabels) {
     EXPECT_EQ(s.frame.labels[s.cluster[k]], KeypointLabel::kStatic);
 }
 
+
+TEST(LabelMovers, WithCoherenceOnlyNeighboursThatMovedAlikeConfirm) {
+  const PinholeCamera camera;
+  const ScaleInfo scale = ScaleInfo::Geometric(1.2, 8);
+  MoverCheckOptions options;
+  options.coherence = 0.5;
+  // The mover of MakeScene: every point shifted alike, confirmed as without coherence.
+  Scene mover = MakeScene(camera);
+  std::vector<size_t> confirmed;
+  LabelMovers(camera, scale, options, mover.frame, mover.points, nullptr, &mover.frame.labels,
+              &confirmed);
+  EXPECT_EQ(confirmed, mover.cluster);
+  // Mismatches: the cluster's points off by as much but each in another direction (as the
+  // associations the pose optimiser rejects on a textured static scene).
+  Scene mismatched = MakeScene(camera);
+  for (size_t k = 0; k < mismatched.cluster.size(); ++k) {
+    const double a = 2.0 * M_PI * static_cast<double>(k) / static_cast<double>(mismatched.cluster.size());
+    *mismatched.points[mismatched.cluster[k]] =
+        camera.Unproject(mismatched.frame.features->undist[mismatched.cluster[k]], 1.5f) +
+        0.1 * Eigen::Vector3d(std::cos(a), std::sin(a), 0);
+  }
+  Scene without = mismatched;
+  EXPECT_EQ(LabelMovers(camera, scale, options, mismatched.frame, mismatched.points, nullptr,
+                        &mismatched.frame.labels, &confirmed),
+            0);
+  EXPECT_TRUE(confirmed.empty());
+  // Without coherence the same mismatches make a mover: what the option must tell apart.
+  LabelMovers(camera, scale, MoverCheckOptions(), without.frame, without.points, nullptr,
+              &without.frame.labels, &confirmed);
+  EXPECT_EQ(confirmed, without.cluster);
+}
 
 TEST(LabelMovers, KeypointsLabelledBeforeAreNoEvidence) {
   // The cluster already labelled (e.g. by a mover region): it confirms nothing, so its unmatched

@@ -276,6 +276,7 @@ void WriteRunOutputs(const RgbdSource& dataset, const Settings& settings, const 
                          {"memory_frames", dyn.memory_frames},
                          {"depth_track_frames", dyn.depth_track_frames},
                          {"geometric_check", dyn.geometric.enabled},
+                         {"geometric_coherence", dyn.geometric.coherence},
                          {"geometric_region_frames", summary.async_segmentation
                                                          ? options.camera_rate_region_frames
                                                          : dyn.geometric.region_frames},
