@@ -296,9 +296,10 @@ python3 "$here/update_section.py" dynamic "bench/bench_dynamic.sh (PARTS=main PR
 cat "$work/section.md"
 fi
 if [[ "$parts" == *" k "* ]]; then
+growth="$("$bin" settings --list | awk '$1 == "Segmentation.CarryGrowth" { print $4 }')"
 {
   echo "Segmenting only every k-th frame (\`--segment-every K\`; masks follow the optical flow and grow"
-  echo "2 px per frame in between), synthetic walking_xyz (\`--realism $realism\`, $frames frames), seed $kseed"
+  echo "$growth px per frame in between, Segmentation.CarryGrowth), synthetic walking_xyz (\`--realism $realism\`, $frames frames), seed $kseed"
   if (( kseed <= 3 )); then echo "(a tuning seed)."; else echo "(an evaluation seed: nothing was chosen on it)."; fi
   echo "Accuracy from replayed dnn masks"
   echo "(sequential), and the live threaded run's own trajectory (the median-fps run) beside it;"

@@ -93,6 +93,8 @@ PY
   done
 done
 
+carry_growth="$("$bin" settings --list | awk '$1 == "Segmentation.CarryGrowth" { print $4 }')"
+export carry_growth
 python3 - "$rows" "$seeds" "$frames" >"$work/section.md" <<'PY'
 import json, os, statistics, sys
 rows = [json.loads(l) for l in open(sys.argv[1])]
@@ -107,7 +109,8 @@ print(f"`detslam run --realtime` on synthetic walking sequences (people from the
       "As a camera delivers decoded images, the frames are decoded from their PNG files before the "
       "camera starts (up to 2 GiB; all of these). Segmentation is asynchronous: the segmentation thread "
       "takes the newest frame whenever it is free, and every frame uses the newest masks carried to it "
-      "by optical flow (mask age = input frames since the frame they were segmented on); a frame whose "
+      "by optical flow (mask age = input frames since the frame they were segmented on), grown by "
+      f"{os.environ['carry_growth']} px per frame of age (Segmentation.CarryGrowth; 2 in runs of this section before 2026-12-07 13:00); a frame whose "
       "masks are more than Segmentation.KeyFrameMaxMaskAge = 6 frames old makes no keyframe (chosen on "
       "walking_xyz tuning seeds 1-3 of the easy generator: mean live ATE 2.70 / 2.65 / 2.64 mm with 4 / 6 / 8, equal within the "
       "run-to-run spread, 3 clearly worse for lack of keyframes; 6 keeps the staleness bound at 0.2 s). The "

@@ -15,13 +15,17 @@ namespace detslam {
 
 struct MaskPropagationOptions {
   int max_corners = 80;       // corners tracked per instance
-  int grow_px_per_frame = 2;  // mask dilation added per frame since the last segmentation
-  int min_tracked = 3;        // fewer tracked corners: the instance keeps its place (still grown)
+  // Mask dilation added per frame since the last segmentation (Segmentation.CarryGrowth). 0
+  // chosen on the tuning seeds (docs/STATUS.md, 2026-12-07): the ring a growing mask withholds
+  // around each person cost more than the limbs it catches (the geometric check and the robust
+  // pose take those); 2 before.
+  int grow_px_per_frame = 0;
+  int min_tracked = 3;  // fewer tracked corners: the instance keeps its place (still grown)
   // The optical flow runs on the images reduced by this factor (1, 2 or 4; each halving is a
   // cv::pyrDown), with the window reduced with them and the same 3 pyramid levels, so that the
   // search reaches as far in full-resolution pixels; the median flow is scaled back. A person's
-  // shift needs no full-resolution flow: the mask moves by whole pixels and grows
-  // grow_px_per_frame per frame anyway. 2 chosen on the
+  // shift needs no full-resolution flow: the mask moves by whole pixels (and grew
+  // 2 px per frame when this was chosen). 2 chosen on the
   // tuning seeds (docs/STATUS.md): carried masks as complete as with 1, the carry 2.5x faster.
   int flow_scale = 2;
   bool Check(std::string* error) const;

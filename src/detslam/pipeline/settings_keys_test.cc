@@ -106,6 +106,9 @@ TEST(SettingsKeysTest, KeysFillTheirFields) {
   EXPECT_FLOAT_EQ(r.segmenter.maskrcnn.score_threshold, 0.4f);
   EXPECT_EQ(
       SlamOptionsFromSettings(WithSet({"Dynamic.MaskDilation=7"}), 1).dynamic.filter.mask_dilation_px, 7);
+  EXPECT_EQ(SlamOptionsFromSettings(WithSet({"Segmentation.CarryGrowth=5"}), 1)
+                .dynamic.propagation.grow_px_per_frame,
+            5);
 }
 
 // --seed reaches every RANSAC: relocalisation and loop verification.
