@@ -296,7 +296,7 @@ python3 "$here/update_section.py" dynamic "bench/bench_dynamic.sh (PARTS=main PR
 cat "$work/section.md"
 fi
 if [[ "$parts" == *" k "* ]]; then
-growth="$("$bin" settings --list | awk '$1 == "Segmentation.CarryGrowth" { print $4 }')"
+growth="$(setting_default Segmentation.CarryGrowth)"
 {
   echo "Segmenting only every k-th frame (\`--segment-every K\`; masks follow the optical flow and grow"
   echo "$growth px per frame in between, Segmentation.CarryGrowth), synthetic walking_xyz (\`--realism $realism\`, $frames frames), seed $kseed"

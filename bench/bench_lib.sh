@@ -8,6 +8,8 @@ publish() {  # section file
 m() { python3 "$here/slam_metrics.py" "$@"; }
 mm() { python3 -c "print(f'{float($1)*1000:.1f}')"; }
 progress() { echo "[$bench_name] $*" >&2; }
+# setting_default KEY: the default value of a settings key in $bin (`detslam settings --list`).
+setting_default() { "$bin" settings --list | awk -v key="$1" '$1 == key { print $4 }'; }
 # cross_check EVAL_JSON: the same ATE and RPE recomputed by the independent
 # tools/tum_eval_reference.py; a disagreement above 1e-6 m stops the benchmark (the result is
 # deleted too, so that a caller in a background job cannot read it either).

@@ -93,7 +93,7 @@ PY
   done
 done
 
-carry_growth="$("$bin" settings --list | awk '$1 == "Segmentation.CarryGrowth" { print $4 }')"
+carry_growth="$(setting_default Segmentation.CarryGrowth)"
 export carry_growth
 python3 - "$rows" "$seeds" "$frames" >"$work/section.md" <<'PY'
 import json, os, statistics, sys
