@@ -4,6 +4,13 @@
 # Per walking preset and evaluation seed (SEEDS; nothing in the camera-rate mode was chosen on any
 # seed), runs of the same frames:
 #   offline   sequential, every frame segmented (the accuracy reference; deterministic)
+#   threaded  `detslam run --threaded`, every frame taken and segmented, no camera: the offline
+#             run's own spread when the mapping thread runs beside tracking (THREADED_REPEATS runs,
+#             default 2; 0 leaves them out). A sequential run maps each keyframe before the next
+#             frame, so its local mapping is always idle and it makes more keyframes than
+#             any threaded run; which frames become keyframes moves a sequence's ATE both ways
+#             (threaded 0.83-1.18x the sequential run on tuning seeds 1-3 of walking_xyz and
+#             walking_halfsphere)
 #   live      `detslam run --realtime`: frames offered at their timestamps (30 fps), dropped when
 #             the pipeline is busy; threaded with the mapping and loop-closing threads;
 #             asynchronous segmentation. LIVE_REPEATS runs (default 3): a live run depends on the
@@ -29,7 +36,7 @@
 # docs/realtime_long.svg; writes section realtime-long.
 # Usage: bench/bench_realtime.sh [path/to/detslam]
 #   (env: PRESETS="walking_xyz walking_static walking_rpy walking_halfsphere", SEEDS="101 102 103",
-#    FRAMES=300, PARTS="live tracking", LIVE_REPEATS=3, REPEATS=5, LONG_FRAMES=20000,
+#    FRAMES=300, PARTS="live tracking", LIVE_REPEATS=3, THREADED_REPEATS=2, REPEATS=5, LONG_FRAMES=20000,
 #    LONG_SEED=101)
 set -euo pipefail
 # The synthetic sensor model (`detslam synth --realism`): realistic, the generator's default;
@@ -43,9 +50,10 @@ seeds="${SEEDS:-101 102 103}"
 frames="${FRAMES:-300}"
 parts="${PARTS:-live tracking}"
 live_repeats="${LIVE_REPEATS:-3}"
+threaded_repeats="${THREADED_REPEATS:-2}"
 long_frames="${LONG_FRAMES:-20000}"
 long_seed="${LONG_SEED:-101}"
-settings_line="bench/bench_realtime.sh (PRESETS=\"$presets\" SEEDS=\"$seeds\" FRAMES=$frames PARTS=\"$parts\" LIVE_REPEATS=$live_repeats$([[ " $parts " != *" long "* ]] || echo " LONG_FRAMES=$long_frames LONG_SEED=$long_seed") REALISM=$realism)"
+settings_line="bench/bench_realtime.sh (PRESETS=\"$presets\" SEEDS=\"$seeds\" FRAMES=$frames PARTS=\"$parts\" LIVE_REPEATS=$live_repeats THREADED_REPEATS=$threaded_repeats$([[ " $parts " != *" long "* ]] || echo " LONG_FRAMES=$long_frames LONG_SEED=$long_seed") REALISM=$realism)"
 work="$(mktemp -d)"
 trap 'rm -rf "$work"' EXIT
 bench_name=bench_realtime
@@ -63,16 +71,23 @@ for preset in $presets; do
     "$bin" synth --realism "$realism" --preset "$preset" --seed "$seed" --frames "$frames" --people "$people" --out "$seq" >/dev/null 2>&1
     progress "$preset seed $seed: offline (sequential)"
     run_eval "$seq" "$seq.offline" --segmenter dnn --models "$models"
+    for rep in $(seq 1 "$threaded_repeats"); do
+      progress "$preset seed $seed: offline threaded (--threaded, every frame), run $rep of $threaded_repeats"
+      run_eval "$seq" "$seq.threaded$rep" --segmenter dnn --models "$models" --threaded
+    done
     for rep in $(seq 1 "$live_repeats"); do
       progress "$preset seed $seed: live (--realtime), run $rep of $live_repeats"
       run_eval "$seq" "$seq.live$rep" --segmenter dnn --models "$models" --realtime
     done
     progress "$preset seed $seed: live (--realtime --sync-segmentation)"
     run_eval "$seq" "$seq.sync" --segmenter dnn --models "$models" --realtime --sync-segmentation
-    python3 - "$seq" "$preset" "$seed" "$live_repeats" >>"$rows" <<'PY'
+    python3 - "$seq" "$preset" "$seed" "$live_repeats" "$threaded_repeats" >>"$rows" <<'PY'
 import json, sys
-seq, preset, seed, repeats = sys.argv[1:5]
+seq, preset, seed, repeats, threaded_repeats = sys.argv[1:6]
 ate = lambda p: json.load(open(p + "/eval.json"))["ate"]["rmse"]
+def made(p):  # keyframes made over the run, and those the map kept (culling removes the others)
+    j = json.load(open(p + "/run.json"))
+    return f'{sum(bool(f.get("keyframe")) for f in j["per_frame"])} ({j["keyframes"]})'
 runs = []  # one per live run, in run order
 for k in range(1, int(repeats) + 1):
     live = json.load(open(f"{seq}.live{k}/run.json"))
@@ -87,6 +102,9 @@ for k in range(1, int(repeats) + 1):
                  "burst": t.get("keyframes_mapped_in_burst", -1)})
 print(json.dumps({"preset": preset, "seed": int(seed), "runs": runs,
                   "ate_offline": ate(seq + ".offline"),
+                  "offline_keyframes": made(seq + ".offline"),
+                  "threaded": [{"ate": ate(f"{seq}.threaded{k}"), "keyframes": made(f"{seq}.threaded{k}")}
+                               for k in range(1, int(threaded_repeats) + 1)],
                   "sync_fps": json.load(open(seq + ".sync/run.json"))["realtime"]["processed_fps"],
                   "ate_sync": ate(seq + ".sync")}))
 PY
@@ -129,7 +147,14 @@ print(f"`detslam run --realtime` on synthetic walking sequences (people from the
       "and segments every frame. Keyframes: made in the live run (deferred: frames whose keyframe waited "
       "for fresher masks; burst: mapped without fusion or bundle adjustment because more keyframes "
       "waited, as ORB-SLAM3's local mapping does). Columns `sync`: the same camera-rate run with "
-      "--sync-segmentation (each frame taken is segmented before extraction). The frame-rate target "
+      "--sync-segmentation (each frame taken is segmented before extraction). Columns `threaded`: "
+      "`detslam run --threaded` on the same frames, every frame taken and segmented, no camera and no "
+      "frame dropped (the offline run with the mapping thread beside tracking; THREADED_REPEATS runs): "
+      "a sequential run maps each keyframe before the next frame, so its local mapping is always idle "
+      "and, by ORB-SLAM3's keyframe rule, it makes more keyframes than any threaded run (made, and in brackets kept after culling); "
+      "which frames become keyframes moves a sequence's ATE both ways, so these runs show how far an "
+      "offline run with threads lies from the sequential one before any camera-rate effect. "
+      "The frame-rate target "
       "reads the issue's \"at least 30 fps processed (at most 2 % of frames dropped)\" as processed fps "
       "at least 98 % of the camera's 30 fps: frames offered at 30 fps give 30.0 processed fps only "
       "when not one frame is dropped.\n")
@@ -142,6 +167,12 @@ for r in rows:  # per sequence: the mean over its live runs and the worst single
     r["m"] = {k: mean(run[k] for run in r["runs"]) for k in
               ("fps", "drop_pct", "lat_median", "lat_p99", "ate_live", "ratio", "segmented",
                "age_median", "keyframes", "deferred", "burst")}
+    th = r.get("threaded", [])
+    r["th_ratio"] = [t["ate"] / r["ate_offline"] for t in th]
+    # The offline runs together: the sequential one and the threaded ones, every frame segmented.
+    offline_all = [r["ate_offline"]] + [t["ate"] for t in th]
+    r["ate_offline_all"] = mean(offline_all)
+    r["ratio_all"] = r["m"]["ate_live"] / r["ate_offline_all"]
     r["worst"] = {"fps": min(run["fps"] for run in r["runs"]),
                   "drop_pct": max(run["drop_pct"] for run in r["runs"]),
                   "lat_p99": max(run["lat_p99"] for run in r["runs"]),
@@ -153,8 +184,8 @@ print(f"Each sequence ran live {n_runs} times (LIVE_REPEATS): a live run depends
       "mean over its live runs and, in brackets, the worst single run; the targets are checked on each "
       "sequence's mean (what a user gets on average) and the worst single run is printed beside each. "
       "Runs of this section before 2026-12-07 06:00 made one live run per sequence.\n")
-print("| preset | seed | processed fps | dropped % | latency median ms | latency p99 ms | frames segmented | mask age median / max | keyframes (deferred, burst) | processed frames tracked | ATE live mm | ATE offline mm | ATE ratio | sync fps | sync ATE ratio |")
-print("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")
+print("| preset | seed | processed fps | dropped % | latency median ms | latency p99 ms | frames segmented | mask age median / max | keyframes (deferred, burst) | processed frames tracked | ATE live mm | ATE offline mm | ATE ratio | sync fps | sync ATE ratio | threaded ATE mm (runs) | threaded ATE ratio (runs) | keyframes made (kept), offline / threaded |")
+print("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")
 for r in rows:
     m, w = r["m"], r["worst"]
     tracked = sum(run["tracked"] for run in r["runs"])
@@ -163,7 +194,11 @@ for r in rows:
           f'{m["lat_median"]:.0f} | {m["lat_p99"]:.0f} ({w["lat_p99"]:.0f}) | {m["segmented"]:.0f} | '
           f'{m["age_median"]:.1f} / {w["age_max"]:.0f} | {m["keyframes"]:.0f} ({m["deferred"]:.0f}, {m["burst"]:.0f}) | '
           f'{tracked}/{processed} | {1000 * m["ate_live"]:.1f} ({1000 * w["ate_live"]:.1f}) | {1000 * r["ate_offline"]:.1f} | '
-          f'{m["ratio"]:.2f} ({w["ratio"]:.2f}) | {r["sync_fps"]:.1f} | {r["ate_sync"] / r["ate_offline"]:.2f} |')
+          f'{m["ratio"]:.2f} ({w["ratio"]:.2f}) | {r["sync_fps"]:.1f} | {r["ate_sync"] / r["ate_offline"]:.2f} | '
+          + (" / ".join(f'{1000 * t["ate"]:.1f}' for t in r["threaded"]) + " | "
+             + " / ".join(f"{x:.2f}" for x in r["th_ratio"]) + " | "
+             + f'{r["offline_keyframes"]} / ' + " / ".join(str(t["keyframes"]) for t in r["threaded"]) + " |"
+             if r.get("threaded") else "- | - | - |"))
 def agg(key):
     v = [key(r) for r in rows]
     return statistics.fmean(v), (statistics.pstdev(v) if len(v) > 1 else 0.0), v
@@ -180,7 +215,15 @@ print(f"\nOver the {len(rows)} sequences' means (mean, sd, worst sequence): proc
       f"{p99_m:.0f} ms (sd {p99_sd:.0f}, worst {max(p99):.0f}); ATE ratio {ratio_m:.2f} (sd {ratio_sd:.2f}, "
       f"worst {max(ratio):.2f}); processed frames without a pose in all {len(all_runs)} runs: {untracked}. "
       f"With --sync-segmentation (one run per sequence): "
-      f"{sfps_m:.1f} fps (worst {min(sfps):.1f}), ATE ratio {sratio_m:.2f} (worst {max(sratio):.2f}).\n")
+      f"{sfps_m:.1f} fps (worst {min(sfps):.1f}), ATE ratio {sratio_m:.2f} (worst {max(sratio):.2f}).", end="")
+th_all = [x for r in rows for x in r["th_ratio"]]
+if th_all:
+    th_seq = [statistics.fmean(r["th_ratio"]) for r in rows if r["th_ratio"]]
+    print(f" Offline threaded runs ({len(th_all)}, every frame segmented, no camera): ATE ratio to the "
+          f"sequential run {statistics.fmean(th_all):.2f} mean (sd {statistics.pstdev(th_all):.2f}, range "
+          f"{min(th_all):.2f}-{max(th_all):.2f}; worst sequence's mean {max(th_seq):.2f}), "
+          f"{sum(abs(x - 1) > 0.10 for x in th_all)} of {len(th_all)} more than 10 % off it.", end="")
+print("\n")
 def target(name, ok, detail):
     print(f"- {name}: {'met' if ok else 'MISSED'} ({detail})")
 def single(key, ok, worst):
@@ -196,6 +239,14 @@ target("pose latency p99 at most 60 ms", max(p99) <= 60,
 target("live ATE within 10 % of the offline run's", max(ratio) <= 1.10,
        f"worst sequence {max(ratio):.2f}; " + single(lambda x: x["ratio"], lambda x: x <= 1.10, lambda v: f"{max(v):.2f}"))
 target("every processed frame tracked (every run)", untracked == 0, f"{untracked} without a pose")
+if th_all:
+    ra = [r["ratio_all"] for r in rows]
+    print("\nThe ATE target read against all offline runs of a sequence (the mean of the sequential run and "
+          "the threaded ones, every frame segmented), so that the reference is not one draw of the "
+          "keyframe choice: live ATE within 10 % of it: "
+          f"{'met' if max(ra) <= 1.10 else 'MISSED'} (mean {statistics.fmean(ra):.2f}, worst sequence "
+          f"{max(ra):.2f}, {sum(x <= 1.10 for x in ra)} of {len(ra)} sequences within). The issue's "
+          "reading above (the sequential run) stays the target.")
 PY
 publish realtime "$work/section.md"
 fi
