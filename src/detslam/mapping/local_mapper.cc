@@ -20,6 +20,7 @@ namespace detslam {
 bool LocalMapperOptions::Check(std::string* error) const {
   std::ostringstream os;
   if (ba_iterations < 1) os << "ba_iterations must be >= 1; ";
+  if (ba_dense_schur_max_poses < 0) os << "ba_dense_schur_max_poses must be >= 0; ";
   if (max_local_keyframes < 1) os << "max_local_keyframes must be >= 1; ";
   if (triangulation_neighbours < 1) os << "triangulation_neighbours must be >= 1; ";
   if (!(redundancy > 0 && redundancy <= 1)) os << "redundancy must be in (0, 1]; ";
@@ -163,6 +164,7 @@ void LocalMapper::LocalBundleAdjustment(MapStore* store, KeyFrameId current,
   auto solve = [&](MapBundle& bundle) {
     BundleOptions bo;
     bo.max_iterations = options_.ba_iterations;
+    bo.dense_schur_max_poses = options_.ba_dense_schur_max_poses;
     return SolveBundle(camera_, &bundle.problem, bo, abort_ba);
   };
   auto apply = [&](Map& map, const MapBundle& bundle, const BundleSummary& s) {

@@ -19,6 +19,7 @@ namespace detslam {
 struct LocalMapperOptions {
   bool local_ba = true;           // run local bundle adjustment after each keyframe
   int ba_iterations = 10;         // Levenberg-Marquardt iterations
+  int ba_dense_schur_max_poses = 64;  // BundleOptions::dense_schur_max_poses (0: Ceres)
   int max_local_keyframes = 20;   // optimised keyframes: current + best covisibles
   int max_fixed_keyframes = 40;   // keyframes observing local points, kept fixed
   bool fuse = true;               // SearchInNeighbors

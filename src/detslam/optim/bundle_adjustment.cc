@@ -10,6 +10,7 @@
 #include "detslam/core/check.h"
 #include "detslam/geometry/projection.h"
 #include "detslam/optim/cost_functions.h"
+#include "detslam/optim/schur_bundle.h"
 
 namespace detslam {
 namespace {
@@ -37,6 +38,29 @@ void ChooseLinearSolver(ceres::Solver::Options* options) {
   }
 }
 
+// Per observation: chi2 above its threshold or the point not in front of the camera.
+std::vector<bool> ClassifyObservations(const PinholeCamera& camera, const BundleProblem& problem,
+                                       const BundleOptions& options) {
+  std::vector<bool> outlier(problem.observations.size(), false);
+  for (size_t i = 0; i < problem.observations.size(); ++i) {
+    const BundleProblem::Observation& o = problem.observations[i];
+    const Eigen::Vector3d p_cam =
+        problem.poses[o.pose_index].cam_from_world * problem.points[o.point_index].p_world;
+    if (p_cam.z() <= 0.0) {
+      outlier[i] = true;
+      continue;
+    }
+    const Eigen::Vector3d r =
+        WhitenedStereoResidual(camera, p_cam, o.uv, o.u_right, std::sqrt(o.inv_sigma2));
+    outlier[i] = o.u_right >= 0.0 ? r.squaredNorm() > options.chi2_stereo
+                                  : r.head<2>().squaredNorm() > options.chi2_mono;
+  }
+  return outlier;
+}
+
+BundleSummary SolveWithCeres(const PinholeCamera& camera, BundleProblem* problem,
+                             const BundleOptions& options, const std::atomic<bool>* abort_flag);
+
 }  // namespace
 
 bool BundleOptions::Check(std::string* error) const {
@@ -44,6 +68,7 @@ bool BundleOptions::Check(std::string* error) const {
   if (max_iterations <= 0) os << "max_iterations must be positive; ";
   if (!(chi2_mono > 0.0) || !(chi2_stereo > 0.0)) os << "chi2 thresholds must be positive; ";
   if (num_threads <= 0) os << "num_threads must be positive; ";
+  if (dense_schur_max_poses < 0) os << "dense_schur_max_poses must not be negative; ";
   if (error != nullptr) *error = os.str();
   return os.str().empty();
 }
@@ -64,7 +89,21 @@ BundleSummary SolveBundle(const PinholeCamera& camera, BundleProblem* problem,
   bool any_fixed = false;
   for (const BundleProblem::Pose& p : problem->poses) any_fixed = any_fixed || p.fixed;
   if (!any_fixed) return summary;
+  size_t free_poses = 0;
+  for (const BundleProblem::Pose& p : problem->poses) free_poses += p.fixed ? 0 : 1;
+  if (free_poses <= static_cast<size_t>(options.dense_schur_max_poses)) {
+    summary = SolveBundleDenseSchur(camera, problem, options, abort_flag);
+    summary.outlier = ClassifyObservations(camera, *problem, options);
+    return summary;
+  }
+  return SolveWithCeres(camera, problem, options, abort_flag);
+}
 
+namespace {
+
+BundleSummary SolveWithCeres(const PinholeCamera& camera, BundleProblem* problem,
+                             const BundleOptions& options, const std::atomic<bool>* abort_flag) {
+  BundleSummary summary;
   // Parameter storage: quaternion [x, y, z, w] and translation per pose, 3 values per point.
   const size_t num_poses = problem->poses.size();
   std::vector<double> q(4 * num_poses), t(3 * num_poses), x(3 * problem->points.size());
@@ -149,20 +188,10 @@ BundleSummary SolveBundle(const PinholeCamera& camera, BundleProblem* problem,
   for (size_t j = 0; j < problem->points.size(); ++j) {
     if (!problem->points[j].fixed) problem->points[j].p_world = Eigen::Vector3d(&x[3 * j]);
   }
-  for (size_t i = 0; i < problem->observations.size(); ++i) {
-    const BundleProblem::Observation& o = problem->observations[i];
-    const Eigen::Vector3d p_cam =
-        problem->poses[o.pose_index].cam_from_world * problem->points[o.point_index].p_world;
-    if (p_cam.z() <= 0.0) {
-      summary.outlier[i] = true;
-      continue;
-    }
-    const Eigen::Vector3d r =
-        WhitenedStereoResidual(camera, p_cam, o.uv, o.u_right, std::sqrt(o.inv_sigma2));
-    summary.outlier[i] = o.u_right >= 0.0 ? r.squaredNorm() > options.chi2_stereo
-                                          : r.head<2>().squaredNorm() > options.chi2_mono;
-  }
+  summary.outlier = ClassifyObservations(camera, *problem, options);
   return summary;
 }
+
+}  // namespace
 
 }  // namespace detslam

@@ -42,6 +42,9 @@ struct BundleOptions {
   double chi2_mono = 5.991;    // Huber delta^2 and outlier threshold, (u, v) residuals
   double chi2_stereo = 7.815;  // Huber delta^2 and outlier threshold, (u, v, u_right) residuals
   int num_threads = 1;         // Ceres evaluation / linear solver threads
+  // Up to this many non-fixed poses the hand-written dense-Schur solver runs (schur_bundle.h: a
+  // local BA's window); above it Ceres's sparse Schur (global BA). 0: always Ceres.
+  int dense_schur_max_poses = 64;
 
   bool Check(std::string* error) const;
 };

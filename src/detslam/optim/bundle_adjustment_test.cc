@@ -89,17 +89,33 @@ double MeanPointError(const BundleProblem& a, const BundleProblem& b) {
   return sum / a.points.size();
 }
 
-TEST(BundleAdjustmentTest, MovesPosesAndPointsTowardsTheTruth) {
+// Every test runs with both solvers: Ceres's sparse Schur (dense_schur_max_poses 0) and the
+// hand-written dense Schur (schur_bundle.h; the default for windows up to 64 free poses).
+class BundleAdjustmentTest : public ::testing::TestWithParam<int> {
+ protected:
+  BundleOptions Options() const {
+    BundleOptions o;
+    o.dense_schur_max_poses = GetParam();
+    return o;
+  }
+};
+
+INSTANTIATE_TEST_SUITE_P(Solvers, BundleAdjustmentTest, ::testing::Values(0, 64),
+                         [](const ::testing::TestParamInfo<int>& info) {
+                           return info.param == 0 ? std::string("Ceres") : std::string("DenseSchur");
+                         });
+
+TEST_P(BundleAdjustmentTest, MovesPosesAndPointsTowardsTheTruth) {
   Rng rng(1);
   Scene s = MakeScene(rng);
   ASSERT_GT(s.problem.observations.size(), 1000u);
   const double pose_before = MeanPoseError(s.problem, s.truth);
   const double point_before = MeanPointError(s.problem, s.truth);
   const Rigid3d first = s.problem.poses[0].cam_from_world;
-  const BundleSummary summary = SolveBundle(URightCamera(), &s.problem, BundleOptions());
+  const BundleSummary summary = SolveBundle(URightCamera(), &s.problem, Options());
   ASSERT_TRUE(summary.usable);
   EXPECT_GT(summary.iterations, 0);
-  EXPECT_LE(summary.iterations, BundleOptions().max_iterations);
+  EXPECT_LE(summary.iterations, Options().max_iterations);
   EXPECT_LT(summary.final_cost, 0.1 * summary.initial_cost);
   const double pose_after = MeanPoseError(s.problem, s.truth);
   const double point_after = MeanPointError(s.problem, s.truth);
@@ -117,14 +133,14 @@ TEST(BundleAdjustmentTest, MovesPosesAndPointsTowardsTheTruth) {
 
 // With the disparity model (the default camera) and data of that model, BA converges, and it
 // recovers the points better than the u_right model does on the same data.
-TEST(BundleAdjustmentTest, DisparityModelWeightsDepthByItsNoise) {
+TEST_P(BundleAdjustmentTest, DisparityModelWeightsDepthByItsNoise) {
   const PinholeCamera camera;  // disparity_sigma 0.1 px
   ASSERT_GT(camera.disparity_sigma, 0.0);
   Rng rng(5);
   Scene s = MakeScene(rng, camera);
   BundleProblem with_u_right = s.problem;
   const double point_before = MeanPointError(s.problem, s.truth);
-  const BundleSummary summary = SolveBundle(camera, &s.problem, BundleOptions());
+  const BundleSummary summary = SolveBundle(camera, &s.problem, Options());
   ASSERT_TRUE(summary.usable);
   EXPECT_LT(MeanPoseError(s.problem, s.truth), 0.01);
   const double point_after = MeanPointError(s.problem, s.truth);
@@ -132,12 +148,12 @@ TEST(BundleAdjustmentTest, DisparityModelWeightsDepthByItsNoise) {
   int flagged = 0;
   for (const bool o : summary.outlier) flagged += o ? 1 : 0;
   EXPECT_LT(flagged, 0.1 * summary.outlier.size());
-  ASSERT_TRUE(SolveBundle(URightCamera(), &with_u_right, BundleOptions()).usable);
+  ASSERT_TRUE(SolveBundle(URightCamera(), &with_u_right, Options()).usable);
   EXPECT_LT(point_after, MeanPointError(with_u_right, s.truth))
       << point_after << " vs " << MeanPointError(with_u_right, s.truth);
 }
 
-TEST(BundleAdjustmentTest, FlagsCorruptedObservations) {
+TEST_P(BundleAdjustmentTest, FlagsCorruptedObservations) {
   Rng rng(2);
   Scene s = MakeScene(rng);
   std::vector<size_t> corrupted;
@@ -146,18 +162,18 @@ TEST(BundleAdjustmentTest, FlagsCorruptedObservations) {
     corrupted.push_back(k);
   }
   ASSERT_GE(corrupted.size(), 10u);
-  const BundleSummary summary = SolveBundle(URightCamera(), &s.problem, BundleOptions());
+  const BundleSummary summary = SolveBundle(URightCamera(), &s.problem, Options());
   ASSERT_TRUE(summary.usable);
   for (const size_t k : corrupted) EXPECT_TRUE(summary.outlier[k]) << k;
   EXPECT_LT(MeanPoseError(s.problem, s.truth), 0.01);
 }
 
-TEST(BundleAdjustmentTest, AbortFlagStopsBeforeTheFirstStep) {
+TEST_P(BundleAdjustmentTest, AbortFlagStopsBeforeTheFirstStep) {
   Rng rng(3);
   Scene s = MakeScene(rng);
   const BundleProblem before = s.problem;
   const std::atomic<bool> abort(true);
-  const BundleSummary summary = SolveBundle(URightCamera(), &s.problem, BundleOptions(), &abort);
+  const BundleSummary summary = SolveBundle(URightCamera(), &s.problem, Options(), &abort);
   EXPECT_EQ(summary.iterations, 0);
   EXPECT_EQ(summary.final_cost, summary.initial_cost);
   for (size_t i = 0; i < before.poses.size(); ++i) {
@@ -167,25 +183,47 @@ TEST(BundleAdjustmentTest, AbortFlagStopsBeforeTheFirstStep) {
   EXPECT_EQ(MeanPointError(s.problem, before), 0.0);
   // An unset flag does not interfere.
   const std::atomic<bool> go(false);
-  EXPECT_GT(SolveBundle(URightCamera(), &s.problem, BundleOptions(), &go).iterations, 0);
+  EXPECT_GT(SolveBundle(URightCamera(), &s.problem, Options(), &go).iterations, 0);
 }
 
-TEST(BundleAdjustmentTest, NoFixedPoseIsNotUsableAndBadInputThrows) {
+TEST_P(BundleAdjustmentTest, NoFixedPoseIsNotUsableAndBadInputThrows) {
   Rng rng(4);
   Scene s = MakeScene(rng);
   s.problem.poses[0].fixed = false;
   const BundleProblem before = s.problem;
-  const BundleSummary summary = SolveBundle(URightCamera(), &s.problem, BundleOptions());
+  const BundleSummary summary = SolveBundle(URightCamera(), &s.problem, Options());
   EXPECT_FALSE(summary.usable);
   EXPECT_EQ(MeanPoseError(s.problem, before), 0.0);
   s.problem.poses[0].fixed = true;
   s.problem.observations[0].point_index = s.problem.points.size();
-  EXPECT_THROW(SolveBundle(URightCamera(), &s.problem, BundleOptions()), InputError);
-  BundleOptions bad;
+  EXPECT_THROW(SolveBundle(URightCamera(), &s.problem, Options()), InputError);
+  BundleOptions bad = Options();
   bad.max_iterations = 0;
   std::string error;
   EXPECT_FALSE(bad.Check(&error));
   EXPECT_THROW(SolveBundle(URightCamera(), &s.problem, bad), InputError);
+}
+
+// The two solvers reach the same optimum: the same cost to 1 % and the same poses and points to
+// well under the noise, from the same start (one scene, both observation models).
+TEST(BundleAdjustmentSolvers, DenseSchurAndCeresAgree) {
+  for (const bool disparity : {false, true}) {
+    const PinholeCamera camera = disparity ? PinholeCamera() : URightCamera();
+    Rng rng(disparity ? 7 : 6);
+    const Scene s = MakeScene(rng, camera);
+    BundleProblem ceres = s.problem, dense = s.problem;
+    BundleOptions ceres_options, dense_options;
+    ceres_options.dense_schur_max_poses = 0;
+    ceres_options.max_iterations = dense_options.max_iterations = 50;
+    const BundleSummary a = SolveBundle(camera, &ceres, ceres_options);
+    const BundleSummary b = SolveBundle(camera, &dense, dense_options);
+    ASSERT_TRUE(a.usable && b.usable);
+    EXPECT_NEAR(b.initial_cost, a.initial_cost, 1e-9 * a.initial_cost);
+    EXPECT_NEAR(b.final_cost, a.final_cost, 0.01 * a.final_cost) << "disparity " << disparity;
+    EXPECT_LT(MeanPoseError(dense, ceres), 1e-4) << "disparity " << disparity;
+    EXPECT_LT(MeanPointError(dense, ceres), 1e-3) << "disparity " << disparity;
+    EXPECT_EQ(a.outlier, b.outlier);
+  }
 }
 
 }  // namespace

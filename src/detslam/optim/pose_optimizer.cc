@@ -6,6 +6,7 @@
 
 #include "detslam/core/check.h"
 #include "detslam/geometry/projection.h"
+#include "detslam/optim/robust_cost.h"
 
 namespace detslam {
 namespace {
@@ -32,18 +33,6 @@ bool Residual(const PinholeCamera& camera, const Observation& o, const Rigid3d& 
   *r = WhitenedStereoResidual(camera, *p_cam, o.obs->uv, o.obs->u_right, o.sqrt_info);
   if (!o.stereo) (*r)(2) = 0.0;
   return true;
-}
-
-// Huber cost rho(s) of the squared Mahalanobis norm s and the IRLS weight rho'(s).
-void Robustify(double s, double delta, bool robust, double* cost, double* weight) {
-  if (!robust || s <= delta * delta) {
-    *cost = s;
-    *weight = 1.0;
-    return;
-  }
-  const double e = std::sqrt(s);
-  *cost = 2.0 * delta * e - delta * delta;
-  *weight = delta / e;
 }
 
 class PoseProblem {
