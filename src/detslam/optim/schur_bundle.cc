@@ -163,7 +163,6 @@ class Window {
     s_.setZero(6 * np, 6 * np);
     Eigen::VectorXd rhs(6 * np);
     double model = 0.0;  // lambda * delta^T D delta, completed below
-    std::vector<Vector6d> dpose(np);
     for (int k = 0; k < np; ++k) {
       const Vector6d d = Clamped<6>(hpp_[k].diagonal());
       s_.block<6, 6>(6 * k, 6 * k) = hpp_[k];
