@@ -86,11 +86,9 @@ BundleSummary SolveBundle(const PinholeCamera& camera, BundleProblem* problem,
   }
   BundleSummary summary;
   summary.outlier.assign(problem->observations.size(), false);
-  bool any_fixed = false;
-  for (const BundleProblem::Pose& p : problem->poses) any_fixed = any_fixed || p.fixed;
-  if (!any_fixed) return summary;
   size_t free_poses = 0;
   for (const BundleProblem::Pose& p : problem->poses) free_poses += p.fixed ? 0 : 1;
+  if (free_poses == problem->poses.size()) return summary;  // no fixed pose: gauge free
   if (free_poses <= static_cast<size_t>(options.dense_schur_max_poses)) {
     summary = SolveBundleDenseSchur(camera, problem, options, abort_flag);
     summary.outlier = ClassifyObservations(camera, *problem, options);

@@ -14,8 +14,6 @@ namespace {
 using Matrix6d = Eigen::Matrix<double, 6, 6>;
 using Vector6d = Eigen::Matrix<double, 6, 1>;
 
-constexpr double kMinDepth = 1e-6;
-
 struct Observation {
   const PoseObservation* obs;
   bool stereo;
@@ -24,15 +22,11 @@ struct Observation {
   double sqrt_info;  // sqrt of the keypoint octave's information
 };
 
-// Whitened residual (WhitenedStereoResidual; third entry 0 for a mono observation); false when
-// the point is not in front.
+// Whitened residual (ObservationResidual); false when the point is not in front.
 bool Residual(const PinholeCamera& camera, const Observation& o, const Rigid3d& pose,
               Eigen::Vector3d* p_cam, Eigen::Vector3d* r) {
   *p_cam = pose * o.obs->point_world;
-  if (p_cam->z() <= kMinDepth) return false;
-  *r = WhitenedStereoResidual(camera, *p_cam, o.obs->uv, o.obs->u_right, o.sqrt_info);
-  if (!o.stereo) (*r)(2) = 0.0;
-  return true;
+  return ObservationResidual(camera, *p_cam, o.obs->uv, o.obs->u_right, o.sqrt_info, o.stereo, r);
 }
 
 class PoseProblem {

@@ -21,7 +21,6 @@ using Vector6d = Eigen::Matrix<double, 6, 1>;
 using Matrix63 = Eigen::Matrix<double, 6, 3>;
 using Matrix36 = Eigen::Matrix<double, 3, 6>;
 
-constexpr double kMinDepth = 1e-6;
 // Ceres's Solver::Options defaults for the trust region and the stopping rules.
 constexpr double kInitialRadius = 1e4;
 constexpr double kMaxRadius = 1e16;
@@ -163,10 +162,11 @@ class Window {
     s_.setZero(6 * np, 6 * np);
     Eigen::VectorXd rhs(6 * np);
     double model = 0.0;  // lambda * delta^T D delta, completed below
+    std::vector<Vector6d> dpose_diag(np);
     for (int k = 0; k < np; ++k) {
-      const Vector6d d = Clamped<6>(hpp_[k].diagonal());
+      dpose_diag[k] = Clamped<6>(hpp_[k].diagonal());
       s_.block<6, 6>(6 * k, 6 * k) = hpp_[k];
-      s_.block<6, 6>(6 * k, 6 * k).diagonal() += lambda * d;
+      s_.block<6, 6>(6 * k, 6 * k).diagonal() += lambda * dpose_diag[k];
       rhs.segment<6>(6 * k) = -gp_[k];
     }
     std::vector<Eigen::Vector3d> dpoint_diag(num_point_vars_);
@@ -205,9 +205,8 @@ class Window {
       dp->resize(0);
     }
     for (int k = 0; k < np; ++k) {
-      const Vector6d d = Clamped<6>(hpp_[k].diagonal());
       const Vector6d x = dp->segment<6>(6 * k);
-      model += lambda * x.dot(d.cwiseProduct(x)) - x.dot(gp_[k]);
+      model += lambda * x.dot(dpose_diag[k].cwiseProduct(x)) - x.dot(gp_[k]);
     }
     dl->resize(num_point_vars_);
     for (int m = 0; m < num_point_vars_; ++m) {
@@ -258,10 +257,8 @@ class Window {
   bool Residual(const Term& t, const Rigid3d& pose, const Eigen::Vector3d& p,
                 Eigen::Vector3d* p_cam, Eigen::Vector3d* r) const {
     *p_cam = pose * p;
-    if (!(p_cam->z() > kMinDepth)) return false;
-    *r = WhitenedStereoResidual(camera_, *p_cam, t.obs->uv, t.obs->u_right, t.sqrt_info);
-    if (!t.stereo) (*r)(2) = 0.0;
-    return true;
+    return ObservationResidual(camera_, *p_cam, t.obs->uv, t.obs->u_right, t.sqrt_info, t.stereo,
+                               r);
   }
 
   template <int N>
