@@ -244,6 +244,7 @@ void WriteRunOutputs(const RgbdSource& dataset, const Settings& settings, const 
         {"keyframes_mapped_in_burst", summary.keyframes_mapped_in_burst}};
     if (summary.async_segmentation) {
       j["realtime"]["frames_segmented"] = summary.frames_segmented;
+      j["realtime"]["segmentation_headroom_wait_ms"] = summary.headroom_wait_ms;
       j["realtime"]["mask_age_frames"] = {{"median", summary.mask_age.median},
                                           {"mean", summary.mask_age.mean},
                                           {"max", summary.mask_age.max}};

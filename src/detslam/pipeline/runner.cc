@@ -18,6 +18,7 @@
 #include <opencv2/core/utility.hpp>
 
 #include "detslam/core/check.h"
+#include "detslam/core/cpu_load.h"
 #include "detslam/dynamic/mask_carrier.h"
 #include "detslam/pipeline/bounded_queue.h"
 #include "detslam/pipeline/keyframe_mask_recorder.h"
@@ -178,9 +179,10 @@ class RunRecorder {
 
   // Asynchronous segmentation: the segmenter's time on each frame it segmented (they replace the
   // per-frame times, which are then those of carrying the masks).
-  void SetAsyncSegmentation(const std::vector<double>& detection_ms) {
+  void SetAsyncSegmentation(const std::vector<double>& detection_ms, double headroom_wait_ms = 0) {
     summary_.async_segmentation = true;
     summary_.frames_segmented = detection_ms.size();
+    summary_.headroom_wait_ms = headroom_wait_ms;
     seg_ = detection_ms;
   }
 
@@ -568,6 +570,7 @@ RunSummary RunThreaded(const RgbdSource& dataset, const Settings& settings,
   BoundedQueue<LoadedFrame> to_segment(1);
   MaskCarrier carrier(options.slam.dynamic.propagation);
   std::vector<double> detection_ms;  // the segmentation thread's until Join
+  double headroom_wait_ms = 0;       // the same
   const auto close_queues = [&] {
     camera.Close();
     loaded.Close();
@@ -604,8 +607,16 @@ RunSummary RunThreaded(const RgbdSource& dataset, const Settings& settings,
           // Asynchronous segmentation runs only at camera rate.
           if (!options.idle_segmentation || !MakeThisThreadIdlePriority())
             LowerThisThreadPriority(options.background_nice);
-          while (std::optional<LoadedFrame> f = to_segment.Pop()) {
-            if (StopRequested(options)) break;
+          CpuHeadroom::Options ho;
+          ho.max_busy = options.camera_rate_max_busy;
+          ho.max_wait = std::chrono::milliseconds(
+              static_cast<int64_t>(options.camera_rate_headroom_max_wait_ms));
+          CpuHeadroom headroom(ho);
+          while (true) {
+            // Waits before taking a frame, so that it takes the newest after the wait.
+            headroom_wait_ms += headroom.Wait(options.stop);
+            std::optional<LoadedFrame> f = to_segment.Pop();
+            if (!f || StopRequested(options)) break;
             FrameInstances d = slam.DetectFrame(SegmentationInput(dataset, *f));
             detection_ms.push_back(d.segmentation_ms);
             slam.OfferOwnMasks(f->index, d.instances, f->images.depth_m);
@@ -782,7 +793,7 @@ RunSummary RunThreaded(const RgbdSource& dataset, const Settings& settings,
     recorder.SetCamera(offered, std::move(dropped),
                        std::chrono::duration<double>(end - camera_start).count());
   }
-  if (async) recorder.SetAsyncSegmentation(detection_ms);
+  if (async) recorder.SetAsyncSegmentation(detection_ms, headroom_wait_ms);
   return Finish(recorder, dataset, settings, options, slam, start, segmenter);
 }
 

@@ -83,6 +83,15 @@ struct RunOptions {
   // Camera-rate mode: the asynchronous segmentation thread under SCHED_IDLE
   // (MakeThisThreadIdlePriority) instead of background_nice.
   bool idle_segmentation = false;
+  // Camera-rate mode: before each frame it takes, the asynchronous segmentation thread waits (up
+  // to camera_rate_headroom_max_wait_ms) while the machine's cores were busy more than this share
+  // of the last 100 ms (Linux /proc/stat, all processes; >= 1: never waits). With every core kept
+  // busy, a virtual machine's host may stop a core for a whole period (about 100 ms on this
+  // project's machines), and a frame in the frames' path then waits for it (docs/STATUS.md).
+  // 0.95 (with 100 ms windows of 10 ms ticks on 2 cores: at least one idle tick) was chosen on
+  // the walking presets' tuning seeds (README, Options).
+  double camera_rate_max_busy = 0.95;
+  double camera_rate_headroom_max_wait_ms = 100;
   // Camera-rate mode: OpenCV's threads during the run (cv::setNumThreads, process-wide; restored
   // after it); 0 keeps OpenCV's default (one per core). Mostly the detector's network uses them:
   // with 1 it runs in the segmentation thread alone, at that thread's lower priority, instead of
@@ -150,6 +159,8 @@ struct RunSummary {
   // the tracker asked for that were not made because the masks were too old.
   bool async_segmentation = false;
   size_t frames_segmented = 0;
+  // RunOptions::camera_rate_max_busy: the segmentation thread's waits for idle cores (ms, summed).
+  double headroom_wait_ms = 0;
   ErrorStats mask_age;
   size_t keyframes_deferred = 0;
   size_t keyframes_stale_masks = 0;  // made with stale masks after waiting (FrameReport)
