@@ -1,5 +1,6 @@
 #include "detslam/core/cpu_load.h"
 
+#include <algorithm>
 #include <fstream>
 #include <sstream>
 #include <thread>
