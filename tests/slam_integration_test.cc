@@ -319,6 +319,11 @@ constexpr int SlowSegmenterMs(int ms) {
 #endif
 }
 
+// Camera rate: a frame's latency less its own extraction and tracking (a new map's initialisation
+// is slow under the sanitizers), i.e. the time it waited; waiting for the detector would be most of
+// the detector's time.
+double WaitedMs(const FrameReport& r) { return r.latency_ms - r.timings.extraction_ms - r.timings.tracking_ms; }
+
 // 60 frames of a static 30 fps sequence at camera rate (threaded, mapping thread), with a segmenter
 // that takes `segmenter_ms` per frame; *options: those of the run.
 RunSummary RunAtCameraRate(const std::string& name, bool async, int segmenter_ms, RunOptions* options,
@@ -422,7 +427,7 @@ TEST(IntegrationRunner, AsynchronousSegmentationDoesNotHoldTheFramesUp) {
   EXPECT_EQ(s.reports.front().mask_age, 0) << "the first frame has its own masks";
   EXPECT_GE(s.reports.front().latency_ms, kSegmenterMs);
   ASSERT_GE(s.reports.size(), 2u);
-  EXPECT_LT(s.reports[1].latency_ms, kSegmenterMs) << "the frames behind the first were queued";
+  EXPECT_LT(WaitedMs(s.reports[1]), kSegmenterMs / 2) << "the frames behind the first were queued";
   EXPECT_GE(s.dropped_frames.size(), static_cast<size_t>(kSegmenterMs / 34 - 1))
       << "the frames arriving while the first waited were not dropped";
   int64_t previous_source = 0;
@@ -471,7 +476,8 @@ TEST(IntegrationRunner, FirstFrameCanBeLeftUntracked) {
   EXPECT_EQ(s.dropped_frames.front(), 0) << "the first frame was processed";
   EXPECT_GT(s.reports.front().index, 0);
   EXPECT_EQ(s.reports.front().mask_source, 0);
-  EXPECT_LT(s.reports.front().latency_ms, kSegmenterMs) << "the first frame tracked waited for the detector";
+  EXPECT_LT(WaitedMs(s.reports.front()), kSegmenterMs / 2)
+      << "the first frame tracked waited for the detector (latency " << s.reports.front().latency_ms << " ms)";
 }
 
 // A segmenter that records the frames it was asked to segment (no instances).

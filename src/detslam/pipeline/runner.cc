@@ -357,10 +357,12 @@ size_t OfferAtCameraRate(const RgbdSource& dataset, const Settings& settings, si
 }
 
 // OpenCV's thread count (cv::setNumThreads) for a scope: `n` > 0 sets it, 0 leaves it; the count
-// before is restored at the end.
+// before is restored at the end. A count already in force is left alone (OpenCV 4.6 with TBB
+// makes a worker arena even for 1 thread; getNumThreads() after setNumThreads(0) reports the
+// pool's size, not 0, so a restore is not always exact).
 class OpenCvThreads {
  public:
-  explicit OpenCvThreads(int n) : before_(cv::getNumThreads()), set_(n > 0) {
+  explicit OpenCvThreads(int n) : before_(cv::getNumThreads()), set_(n > 0 && n != before_) {
     if (set_) cv::setNumThreads(n);
   }
   ~OpenCvThreads() {
